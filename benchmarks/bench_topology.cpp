@@ -1,0 +1,23 @@
+// Topology build throughput on a real ~100k-triangle mesh (CGAL's refined_elephant).
+// Goal (issue 2): at least 5 million triangles per second on one core.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include "infolerp/mesh/topology.hpp"
+#include "support/mesh_io.hpp"
+
+static void BM_Topology_RefinedElephant(benchmark::State& state) {
+  auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("refined_elephant"));
+  if (!m.ok()) {
+    state.SkipWithError(m.error().message().c_str());
+    return;
+  }
+  for (auto _ : state) {
+    auto topo = infolerp::build_topology(*m);
+    benchmark::DoNotOptimize(topo);
+  }
+  state.counters["triangles"] = static_cast<double>(m->triangles.size());
+  state.counters["triangles_per_second"] = benchmark::Counter(
+      static_cast<double>(m->triangles.size()) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Topology_RefinedElephant)->Unit(benchmark::kMillisecond);

@@ -1,0 +1,85 @@
+#pragma once
+// How infolerp runs work in parallel: through the user's job system. The library creates no
+// threads and holds no global state.
+//
+// An executor offers  parallel_for(n, grain, fn)  which calls fn(begin, end) on disjoint ranges
+// that together cover [0, n), from any number of threads, each range at most `grain` long
+// unless the executor chooses to run everything on one thread. Results never depend on how the
+// executor splits: algorithms reduce per fixed chunk (for_each_chunk) and combine in order.
+#include <algorithm>
+#include <concepts>
+#include <cstddef>
+#include <type_traits>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace infolerp {
+
+namespace detail {
+struct range_fn_archetype {
+  void operator()(std::size_t, std::size_t) const {}
+};
+}  // namespace detail
+
+template <class E>
+concept executor = requires(E& e, std::size_t n, std::size_t grain, detail::range_fn_archetype fn) {
+  e.parallel_for(n, grain, fn);
+};
+
+template <class E>
+constexpr bool check_executor() {
+  static_assert(executor<E>,
+                "infolerp: executor type needs `void parallel_for(size_t n, size_t grain, F fn)` calling "
+                "fn(begin, end) over ranges that cover [0, n)");
+  return executor<E>;
+}
+
+// Runs everything on the calling thread, in order. The default executor.
+struct serial_executor {
+  template <class F>
+  void parallel_for(std::size_t n, std::size_t /*grain*/, F&& fn) const {
+    if (n != 0) fn(std::size_t{0}, n);
+  }
+};
+
+#ifdef _OPENMP
+// OpenMP worksharing over chunks of `grain` (dynamic schedule). Offered only when the
+// translation unit is compiled with OpenMP. threads = 0 uses OpenMP's default.
+struct openmp_executor {
+  int threads = 0;
+  template <class F>
+  void parallel_for(std::size_t n, std::size_t grain, F&& fn) const {
+    if (n == 0) return;
+    grain = std::max<std::size_t>(grain, 1);
+    const auto chunks = static_cast<long long>((n + grain - 1) / grain);
+    const int nthreads = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    for (long long c = 0; c < chunks; ++c) {
+      const std::size_t begin = static_cast<std::size_t>(c) * grain;
+      fn(begin, std::min(n, begin + grain));
+    }
+  }
+};
+#endif
+
+// Number of fixed chunks of `grain` elements covering n elements.
+constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
+  grain = grain == 0 ? 1 : grain;
+  return (n + grain - 1) / grain;
+}
+
+// Calls fn(chunk, begin, end) for each fixed chunk [chunk·grain, min(n, (chunk+1)·grain)),
+// in parallel through the executor. Chunk boundaries depend only on n and grain, so a per-chunk
+// reduction combined in chunk order gives the same bits for any executor and thread count.
+template <class E, class F>
+  requires executor<std::remove_cvref_t<E>>
+void for_each_chunk(E&& exec, std::size_t n, std::size_t grain, F&& fn) {
+  grain = grain == 0 ? 1 : grain;
+  const std::size_t chunks = chunk_count(n, grain);
+  exec.parallel_for(chunks, 1, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c) fn(c, c * grain, std::min(n, (c + 1) * grain));
+  });
+}
+
+}  // namespace infolerp

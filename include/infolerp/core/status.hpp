@@ -1,0 +1,124 @@
+#pragma once
+// Status and result types: how every infolerp entry point reports bad input.
+// The library throws nothing and builds with -fno-exceptions -fno-rtti; a failing entry point
+// returns a status whose message names the offending element (triangle 17, bin 3, ...).
+#include <cassert>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+// Internal invariants (not input validation). Override before including any infolerp header.
+#ifndef INFOLERP_ASSERT
+#define INFOLERP_ASSERT(condition) assert(condition)
+#endif
+
+namespace infolerp {
+
+// What went wrong. Input errors only; internal invariants use INFOLERP_ASSERT.
+enum class errc : std::uint8_t {
+  ok = 0,
+  empty_input,          // no vertices, no triangles, no bins, zero viewpoints, 0x0 image ...
+  bad_index_count,      // index count not a multiple of 3
+  index_out_of_range,   // a triangle names a vertex that does not exist
+  non_finite,           // NaN or Inf in positions, texcoords, distributions, distances
+  degenerate_triangle,  // zero-area triangle, or repeated vertex index
+  non_manifold_edge,    // an edge shared by more than two triangles
+  bad_parameter,        // threshold outside [0,1], negative weight, bad option value
+  bad_distribution,     // negative entries, all-zero row, mismatched lengths
+  bad_size,             // buffer sizes that do not match
+  unsupported,          // the input needs a capability the type does not offer
+};
+
+inline constexpr std::uint64_t no_element = ~std::uint64_t{0};
+// The "none" value of 32-bit ids (triangles, clusters, edges).
+inline constexpr std::uint32_t invalid_id = 0xffffffffu;
+
+inline constexpr const char* to_string(errc code) noexcept {
+  switch (code) {
+    case errc::ok: return "ok";
+    case errc::empty_input: return "empty input";
+    case errc::bad_index_count: return "index count not a multiple of 3";
+    case errc::index_out_of_range: return "index out of range";
+    case errc::non_finite: return "non-finite value";
+    case errc::degenerate_triangle: return "degenerate triangle";
+    case errc::non_manifold_edge: return "non-manifold edge";
+    case errc::bad_parameter: return "bad parameter";
+    case errc::bad_distribution: return "bad distribution";
+    case errc::bad_size: return "bad size";
+    case errc::unsupported: return "unsupported";
+  }
+  return "unknown";
+}
+
+// The outcome of an operation: ok, or an error code with a message and the offending element
+// (a triangle, vertex, bin or pixel index; no_element when none applies).
+// Allocation: the message string, only on error.
+class [[nodiscard]] status {
+ public:
+  status() = default;
+  status(errc code, std::string message, std::uint64_t element = no_element)
+      : code_(code), element_(element), message_(std::move(message)) {}
+
+  [[nodiscard]] bool ok() const noexcept { return code_ == errc::ok; }
+  explicit operator bool() const noexcept { return ok(); }
+  [[nodiscard]] errc code() const noexcept { return code_; }
+  [[nodiscard]] std::uint64_t element() const noexcept { return element_; }
+  [[nodiscard]] const std::string& message() const noexcept { return message_; }
+
+ private:
+  errc code_ = errc::ok;
+  std::uint64_t element_ = no_element;
+  std::string message_;
+};
+
+// A value or the status that explains why there is none (std::expected is C++23).
+template <class T>
+class [[nodiscard]] result {
+ public:
+  result(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
+  result(status error) : error_(std::move(error)) {  // NOLINT: implicit by design
+    INFOLERP_ASSERT(!error_.ok() && "a result without a value needs an error status");
+  }
+
+  [[nodiscard]] bool ok() const noexcept { return value_.has_value(); }
+  explicit operator bool() const noexcept { return ok(); }
+  // Preconditions for the accessors below: ok().
+  [[nodiscard]] T& value() & { INFOLERP_ASSERT(ok()); return *value_; }
+  [[nodiscard]] const T& value() const& { INFOLERP_ASSERT(ok()); return *value_; }
+  [[nodiscard]] T&& value() && { INFOLERP_ASSERT(ok()); return std::move(*value_); }
+  T& operator*() & { return value(); }
+  const T& operator*() const& { return value(); }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+  // The error; an ok status when the result holds a value.
+  [[nodiscard]] const status& error() const noexcept { return error_; }
+
+ private:
+  std::optional<T> value_;
+  status error_;
+};
+
+namespace detail {
+// Builds messages without iostreams: text as is, numbers in decimal.
+inline void append_part(std::string& s, const char* part) { s += part; }
+inline void append_part(std::string& s, const std::string& part) { s += part; }
+template <class N>
+  requires std::is_arithmetic_v<N>
+void append_part(std::string& s, N part) {
+  s += std::to_string(part);
+}
+}  // namespace detail
+
+// An error status with a message built from pieces, for example
+//   make_error(errc::index_out_of_range, t, "triangle ", t, ": vertex ", v, " out of range")
+// Allocation: the message string.
+template <class... Parts>
+status make_error(errc code, std::uint64_t element, const Parts&... parts) {
+  std::string message = "infolerp: ";
+  (detail::append_part(message, parts), ...);
+  return status(code, std::move(message), element);
+}
+
+}  // namespace infolerp

@@ -1,0 +1,8 @@
+#pragma once
+// Umbrella header, for convenience only: every infolerp header compiles on its own.
+#include "infolerp/core/executor.hpp"
+#include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/tracer.hpp"
+#include "infolerp/mesh/adaptors.hpp"
+#include "infolerp/mesh/topology.hpp"

@@ -1,0 +1,155 @@
+// core/: status and result, mesh traits and concepts, tracer and executor concepts.
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <atomic>
+#include <numeric>
+#include <vector>
+#include "infolerp/core/executor.hpp"
+#include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/tracer.hpp"
+#include "infolerp/mesh/adaptors.hpp"
+#include "support/thread_pool.hpp"
+
+namespace {
+// A user mesh with different member names, adapted by specialising mesh_traits.
+struct engine_mesh {
+  std::vector<float> xyz;
+  std::vector<std::uint16_t> idx;
+};
+struct missing_position {
+  std::size_t vertex_count() const { return 0; }
+  std::size_t triangle_count() const { return 0; }
+  glm::uvec3 triangle(std::size_t) const { return {}; }
+};
+struct user_tracer {
+  bool occluded(const infolerp::ray& r) const { return r.direction.z < 0; }
+  infolerp::hit intersect(const infolerp::ray&) const { return {}; }
+};
+struct batch_tracer : user_tracer {
+  using user_tracer::intersect;
+  using user_tracer::occluded;
+  mutable int batches = 0;
+  void occluded(std::span<const infolerp::ray> rays, std::span<std::uint8_t> out) const {
+    ++batches;
+    for (std::size_t i = 0; i < rays.size(); ++i) out[i] = occluded(rays[i]) ? 1 : 0;
+  }
+};
+}  // namespace
+
+template <>
+struct infolerp::mesh_traits<engine_mesh> {
+  static std::size_t vertex_count(const engine_mesh& m) { return m.xyz.size() / 3; }
+  static std::size_t triangle_count(const engine_mesh& m) { return m.idx.size() / 3; }
+  static glm::vec3 position(const engine_mesh& m, std::size_t v) { return {m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]}; }
+  static glm::uvec3 triangle(const engine_mesh& m, std::size_t t) { return {m.idx[3 * t], m.idx[3 * t + 1], m.idx[3 * t + 2]}; }
+};
+
+TEST_CASE("status and result carry the error and the element") {
+  const infolerp::status ok;
+  CHECK(ok.ok());
+  const auto bad = infolerp::make_error(infolerp::errc::index_out_of_range, 17, "triangle ", 17, ": vertex ", 9u);
+  CHECK_FALSE(bad.ok());
+  CHECK(bad.code() == infolerp::errc::index_out_of_range);
+  CHECK(bad.element() == 17);
+  CHECK(bad.message() == "infolerp: triangle 17: vertex 9");
+  infolerp::result<int> r = 5;
+  REQUIRE(r.ok());
+  CHECK(*r == 5);
+  infolerp::result<int> e = bad;
+  CHECK_FALSE(e.ok());
+  CHECK(e.error().message() == bad.message());
+  CHECK(std::string(infolerp::to_string(infolerp::errc::non_finite)) == "non-finite value");
+}
+
+TEST_CASE("mesh concepts: members, traits specialisation, optional capabilities") {
+  STATIC_REQUIRE(infolerp::mesh<infolerp::indexed_mesh>);
+  STATIC_REQUIRE(infolerp::textured_mesh<infolerp::indexed_mesh>);
+  STATIC_REQUIRE(infolerp::keyframed_mesh<infolerp::indexed_mesh>);
+  STATIC_REQUIRE(infolerp::mesh<infolerp::mesh_view>);
+  STATIC_REQUIRE_FALSE(infolerp::keyframed_mesh<infolerp::mesh_view>);
+  STATIC_REQUIRE(infolerp::mesh<infolerp::strided_mesh_view>);
+  STATIC_REQUIRE_FALSE(infolerp::textured_mesh<infolerp::strided_mesh_view>);
+  STATIC_REQUIRE(infolerp::mesh<engine_mesh>);
+  STATIC_REQUIRE_FALSE(infolerp::textured_mesh<engine_mesh>);
+  STATIC_REQUIRE_FALSE(infolerp::mesh<missing_position>);
+  STATIC_REQUIRE_FALSE(infolerp::mesh<int>);
+
+  const engine_mesh em{{0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2}};
+  CHECK(infolerp::mesh_vertex_count(em) == 3);
+  CHECK(infolerp::mesh_position(em, 1) == glm::vec3(1, 0, 0));
+  CHECK(infolerp::mesh_triangle(em, 0) == glm::uvec3(0, 1, 2));
+  CHECK_FALSE(infolerp::mesh_has_texcoords(em));
+
+  infolerp::indexed_mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.triangles = {{0, 1, 2}};
+  CHECK_FALSE(infolerp::mesh_has_texcoords(m));  // the type could, this instance does not
+  m.texcoords = {{0, 0}, {1, 0}, {0, 1}};
+  CHECK(infolerp::mesh_has_texcoords(m));
+  CHECK(infolerp::mesh_traits<infolerp::indexed_mesh>::texcoord(m, 0, 2) == glm::vec2(0, 1));
+  CHECK(infolerp::mesh_keyframe_count(m) == 0);
+}
+
+TEST_CASE("strided view reads interleaved vertices without copying, and checks its arguments") {
+  struct vertex { float p[3]; float uv[2]; };
+  const std::array<vertex, 3> verts{{{{0, 0, 0}, {0, 0}}, {{2, 0, 0}, {1, 0}}, {{0, 3, 0}, {0, 1}}}};
+  const std::array<std::uint32_t, 3> idx{0, 1, 2};
+  auto view = infolerp::make_strided_mesh_view(verts[0].p, 3, sizeof(vertex), idx.data(), 3);
+  REQUIRE(view.ok());
+  CHECK(view->triangle_count() == 1);
+  CHECK(view->position(2) == glm::vec3(0, 3, 0));
+  auto bad_count = infolerp::make_strided_mesh_view(verts[0].p, 3, sizeof(vertex), idx.data(), 2);
+  REQUIRE_FALSE(bad_count.ok());
+  CHECK(bad_count.error().code() == infolerp::errc::bad_index_count);
+  CHECK(bad_count.error().message().find("index count 2") != std::string::npos);
+  CHECK(infolerp::make_strided_mesh_view(verts[0].p, 3, 8, idx.data(), 3).error().code() == infolerp::errc::bad_parameter);
+  CHECK(infolerp::make_strided_mesh_view(nullptr, 3, 12, idx.data(), 3).error().code() == infolerp::errc::bad_parameter);
+  CHECK(infolerp::make_strided_mesh_view(verts[0].p, 3, 20, nullptr, 3).error().code() == infolerp::errc::bad_parameter);
+}
+
+TEST_CASE("tracer concepts: batch overload is used when present") {
+  STATIC_REQUIRE(infolerp::tracer<user_tracer>);
+  STATIC_REQUIRE_FALSE(infolerp::batch_occlusion_tracer<user_tracer>);
+  STATIC_REQUIRE(infolerp::batch_occlusion_tracer<batch_tracer>);
+  STATIC_REQUIRE_FALSE(infolerp::tracer<int>);
+  const std::vector<infolerp::ray> rays{{{0, 0, 0}, 0, {0, 0, 1}}, {{0, 0, 0}, 0, {0, 0, -1}}};
+  std::vector<std::uint8_t> out(2, 7);
+  infolerp::trace_occluded(user_tracer{}, rays, out);
+  CHECK(out == std::vector<std::uint8_t>{0, 1});
+  batch_tracer bt;
+  std::fill(out.begin(), out.end(), std::uint8_t{7});
+  infolerp::trace_occluded(bt, rays, out);
+  CHECK(out == std::vector<std::uint8_t>{0, 1});
+  CHECK(bt.batches == 1);
+  CHECK_FALSE(infolerp::hit{}.valid());
+}
+
+TEST_CASE("executors cover every index once, and chunked reductions do not depend on them") {
+  STATIC_REQUIRE(infolerp::executor<infolerp::serial_executor>);
+  STATIC_REQUIRE(infolerp::executor<infolerp::openmp_executor>);
+  STATIC_REQUIRE(infolerp::executor<infolerp::support::thread_pool_executor>);
+  STATIC_REQUIRE_FALSE(infolerp::executor<int>);
+  const std::size_t n = 100003;
+  std::vector<double> values(n);
+  for (std::size_t i = 0; i < n; ++i) values[i] = 1.0 / static_cast<double>(i + 1);
+  auto chunked_sum = [&](auto&& exec) {
+    std::vector<double> partial(infolerp::chunk_count(n, 1000), 0.0);
+    std::vector<std::atomic<int>> seen(n);
+    infolerp::for_each_chunk(exec, n, 1000, [&](std::size_t c, std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        partial[c] += values[i];
+        seen[i].fetch_add(1);
+      }
+    });
+    for (const auto& s : seen) REQUIRE(s.load() == 1);
+    return std::accumulate(partial.begin(), partial.end(), 0.0);
+  };
+  const double serial = chunked_sum(infolerp::serial_executor{});
+  CHECK(chunked_sum(infolerp::openmp_executor{}) == serial);
+  for (unsigned w : {1u, 2u, 8u}) CHECK(chunked_sum(infolerp::support::thread_pool_executor{w}) == serial);
+  int calls = 0;
+  infolerp::serial_executor{}.parallel_for(0, 4, [&](std::size_t, std::size_t) { ++calls; });
+  CHECK(calls == 0);
+}

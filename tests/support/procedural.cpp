@@ -1,0 +1,141 @@
+#include "support/procedural.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <glm/geometric.hpp>
+
+namespace infolerp::support {
+
+namespace {
+constexpr float pi = 3.14159265358979323846f;
+}
+
+indexed_mesh make_icosphere(unsigned level, float radius) {
+  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+  indexed_mesh m;
+  m.positions = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (auto& p : m.positions) p = glm::normalize(p);
+  for (unsigned l = 0; l < level; ++l) {
+    std::map<std::pair<unsigned, unsigned>, unsigned> mid;
+    auto midpoint = [&](unsigned a, unsigned b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      const auto id = static_cast<unsigned>(m.positions.size());
+      m.positions.push_back(glm::normalize(m.positions[a] + m.positions[b]));
+      mid.emplace(key, id);
+      return id;
+    };
+    std::vector<glm::uvec3> next;
+    next.reserve(m.triangles.size() * 4);
+    for (const auto& tri : m.triangles) {
+      const unsigned a = midpoint(tri.x, tri.y), b = midpoint(tri.y, tri.z), c = midpoint(tri.z, tri.x);
+      next.insert(next.end(), {{tri.x, a, c}, {tri.y, b, a}, {tri.z, c, b}, {a, b, c}});
+    }
+    m.triangles = std::move(next);
+  }
+  for (auto& p : m.positions) p *= radius;
+  return m;
+}
+
+indexed_mesh make_torus(unsigned major, unsigned minor, float ring_radius, float tube_radius) {
+  indexed_mesh m;
+  for (unsigned i = 0; i < major; ++i) {
+    const float u = 2.0f * pi * static_cast<float>(i) / static_cast<float>(major);
+    for (unsigned j = 0; j < minor; ++j) {
+      const float v = 2.0f * pi * static_cast<float>(j) / static_cast<float>(minor);
+      const float r = ring_radius + tube_radius * std::cos(v);
+      m.positions.push_back({r * std::cos(u), r * std::sin(u), tube_radius * std::sin(v)});
+    }
+  }
+  for (unsigned i = 0; i < major; ++i)
+    for (unsigned j = 0; j < minor; ++j) {
+      const unsigned i1 = (i + 1) % major, j1 = (j + 1) % minor;
+      const unsigned a = i * minor + j, b = i1 * minor + j, c = i1 * minor + j1, d = i * minor + j1;
+      m.triangles.push_back({a, b, c});
+      m.triangles.push_back({a, c, d});
+    }
+  return m;
+}
+
+indexed_mesh make_uv_sphere(unsigned slices, unsigned stacks, float radius) {
+  indexed_mesh m;
+  // Vertex grid (stacks+1) x (slices+1) with a seam column; texcoords are copied per corner.
+  auto vid = [&](unsigned i, unsigned j) { return i * (slices + 1) + j; };
+  std::vector<glm::vec2> uv;
+  for (unsigned i = 0; i <= stacks; ++i) {
+    const float theta = pi * static_cast<float>(i) / static_cast<float>(stacks);
+    for (unsigned j = 0; j <= slices; ++j) {
+      const float phi = 2.0f * pi * static_cast<float>(j) / static_cast<float>(slices);
+      m.positions.push_back(radius * glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                               std::cos(theta)));
+      uv.push_back({static_cast<float>(j) / static_cast<float>(slices), static_cast<float>(i) / static_cast<float>(stacks)});
+    }
+  }
+  auto emit = [&](unsigned a, unsigned b, unsigned c) {
+    m.triangles.push_back({a, b, c});
+    m.texcoords.insert(m.texcoords.end(), {uv[a], uv[b], uv[c]});
+  };
+  // Quad (i, j): a top-left, b below it, c below-right, d right. At the poles a==d or b==c in
+  // position, so a single triangle is emitted there (no zero-area triangles).
+  for (unsigned i = 0; i < stacks; ++i)
+    for (unsigned j = 0; j < slices; ++j) {
+      const unsigned a = vid(i, j), b = vid(i + 1, j), c = vid(i + 1, j + 1), d = vid(i, j + 1);
+      if (i == 0) {
+        emit(a, b, c);
+      } else if (i + 1 == stacks) {
+        emit(a, b, d);
+      } else {
+        emit(a, b, c);
+        emit(a, c, d);
+      }
+    }
+  // Pole and seam vertices stay duplicated (a UV seam); positions coincide there.
+  return m;
+}
+
+indexed_mesh make_plane(unsigned nx, unsigned ny, float size) {
+  indexed_mesh m;
+  std::vector<glm::vec2> uv;
+  for (unsigned j = 0; j <= ny; ++j)
+    for (unsigned i = 0; i <= nx; ++i) {
+      const glm::vec2 t{static_cast<float>(i) / static_cast<float>(nx), static_cast<float>(j) / static_cast<float>(ny)};
+      m.positions.push_back({(t.x - 0.5f) * size, (t.y - 0.5f) * size, 0.0f});
+      uv.push_back(t);
+    }
+  for (unsigned j = 0; j < ny; ++j)
+    for (unsigned i = 0; i < nx; ++i) {
+      const unsigned a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+      m.triangles.push_back({a, b, c});
+      m.triangles.push_back({a, c, d});
+      m.texcoords.insert(m.texcoords.end(), {uv[a], uv[b], uv[c], uv[a], uv[c], uv[d]});
+    }
+  return m;
+}
+
+indexed_mesh make_box(glm::vec3 lo, glm::vec3 hi) {
+  indexed_mesh m;
+  for (unsigned i = 0; i < 8; ++i)
+    m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  m.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                 {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return m;
+}
+
+void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m) {
+  const bool keep_uv = (dst.triangles.empty() || dst.has_texcoords()) && src.has_texcoords();
+  if (!keep_uv) dst.texcoords.clear();
+  const auto base = static_cast<unsigned>(dst.positions.size());
+  for (const auto& p : src.positions) dst.positions.push_back(glm::vec3(m * glm::vec4(p, 1.0f)));
+  for (const auto& t : src.triangles) dst.triangles.push_back(t + glm::uvec3(base));
+  if (keep_uv) dst.texcoords.insert(dst.texcoords.end(), src.texcoords.begin(), src.texcoords.end());
+  dst.normals.clear();
+}
+
+}  // namespace infolerp::support

@@ -1,0 +1,23 @@
+#pragma once
+// Procedural meshes with known geometry, for analytic tests and the built-in demo scene.
+#include <cstdint>
+#include <glm/mat4x4.hpp>
+#include "infolerp/mesh/adaptors.hpp"
+
+namespace infolerp::support {
+
+// Icosahedron subdivided `level` times (1:4, midpoints pushed to the sphere). Outward winding.
+indexed_mesh make_icosphere(unsigned level, float radius = 1.0f);
+// Torus around +Z: `major` segments around the ring, `minor` around the tube. Outward winding.
+indexed_mesh make_torus(unsigned major, unsigned minor, float ring_radius, float tube_radius);
+// Latitude/longitude sphere around +Z with per-corner texcoords u = longitude/2π,
+// v = colatitude/π (stretch grows toward the poles). slices >= 3, stacks >= 2.
+indexed_mesh make_uv_sphere(unsigned slices, unsigned stacks, float radius = 1.0f);
+// Plane z = 0 over [-size/2, size/2]², nx by ny quads, normal +Z, texcoords in [0,1]².
+indexed_mesh make_plane(unsigned nx, unsigned ny, float size);
+// Axis-aligned box, 8 shared vertices, 12 triangles, outward winding.
+indexed_mesh make_box(glm::vec3 lo, glm::vec3 hi);
+// Appends `src` transformed by `m` to `dst` (texcoords kept only if both have them, or dst is empty).
+void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m = glm::mat4(1.0f));
+
+}  // namespace infolerp::support
