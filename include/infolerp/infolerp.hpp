@@ -6,3 +6,4 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/topology.hpp"
+#include "infolerp/mesh/geometry.hpp"
