@@ -7,3 +7,4 @@
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/info/jensen_shannon.hpp"
