@@ -442,6 +442,12 @@ class subdivision_mesh {
     (void)ok;
     if (may_hang && e.midpoint != invalid_id) queue_.push_back({c, closure_only});
   }
+  // A new interior edge shared by two new children.
+  void attach_inner(std::uint32_t a, std::uint32_t b, std::uint32_t c0, std::uint32_t c1) {
+    auto& e = edges_.get(a, b);
+    e.face[0] = c0;
+    e.face[1] = c1;
+  }
   void detach(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     detail::edge_table::remove_face(edges_.get(a, b), c);
   }
@@ -475,12 +481,9 @@ class subdivision_mesh {
     attach(m1, v[2], c2, true);
     attach(v[2], m2, c2, true);
     attach(m2, v[0], c0, true);
-    attach(m0, m2, c0, false);
-    attach(m0, m2, c3, false);
-    attach(m0, m1, c1, false);
-    attach(m0, m1, c3, false);
-    attach(m1, m2, c2, false);
-    attach(m1, m2, c3, false);
+    attach_inner(m0, m2, c0, c3);
+    attach_inner(m0, m1, c1, c3);
+    attach_inner(m1, m2, c2, c3);
   }
 
   void split_green(std::uint32_t t, int k) {
@@ -499,8 +502,7 @@ class subdivision_mesh {
     attach(m, b, c1, true);
     attach(b, c, c1, false);
     attach(c, a, c0, false);
-    attach(m, c, c0, false);
-    attach(m, c, c1, false);
+    attach_inner(m, c, c0, c1);
   }
 
   // Rule 3: undo the 1:2 split of p and split it 1:4.
