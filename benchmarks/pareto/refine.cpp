@@ -1,4 +1,4 @@
-// infolerp_pareto refine --csv FILE [--png FILE] [--width W --height H]
+// infolerp_pareto refine --csv FILE [--png FILE] [--width W --height H] [--s-req S]
 //
 // The experiment of Oliveira, Santos, Proença (§5, §6, Table 1) on a procedural walkthrough
 // scene: a street with a portico (a row of columns under a roof slab), a long wall behind it and
@@ -113,7 +113,7 @@ scene make_scene() {
     s.normal.push_back(glm::normalize(glm::cross(s.mesh.positions[t.y] - s.mesh.positions[t.x],
                                                  s.mesh.positions[t.z] - s.mesh.positions[t.x])));
   // The sun is behind the portico, so its shadows fall into the street toward the viewer.
-  s.to_sun = glm::normalize(glm::vec3(-0.35f, 0.6f, 0.75f));
+  s.to_sun = glm::normalize(glm::vec3(-0.4f, 0.55f, 0.5f));
   return s;
 }
 
@@ -148,7 +148,7 @@ struct run_result {
 
 template <class E>
 run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::vector<glm::vec3>& reference,
-               infolerp::refinement_criterion criterion, std::size_t budget, E& exec) {
+               infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec) {
   auto sub = infolerp::subdivision_mesh::build(sc.mesh);
   if (!sub.ok()) {
     std::fprintf(stderr, "%s\n", sub.error().message().c_str());
@@ -156,7 +156,7 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   }
   infolerp::driver_options o;
   o.criteria.criterion = criterion;
-  o.criteria.s_req = 0.05f;
+  o.criteria.s_req = s_req;
   o.criteria.batch = 64;
   o.criteria.always_refine_fraction = 0.02f;
   o.criteria.rnd_point_fraction = 1.0f;
@@ -186,14 +186,16 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
 int pareto_refine(int argc, char** argv) {
   std::string csv_path = "refine.csv", png_path;
   std::uint32_t width = 320, height = 240;
+  float s_req = 0.05f;  // S_req for NLD_OS and NLD_IS (the paper does not give its value)
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
     else if (!std::strcmp(argv[i], "--png")) png_path = next();
     else if (!std::strcmp(argv[i], "--width")) width = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--height")) height = static_cast<std::uint32_t>(std::atoi(next().c_str()));
+    else if (!std::strcmp(argv[i], "--s-req")) s_req = static_cast<float>(std::atof(next().c_str()));
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto refine --csv FILE [--png FILE] [--width W] [--height H]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto refine --csv FILE [--png FILE] [--width W] [--height H] [--s-req S]\n");
       return 2;
     }
   }
@@ -201,7 +203,7 @@ int pareto_refine(int argc, char** argv) {
   const std::string stem = png_path.substr(0, png_path.rfind('.'));
 
   const scene sc = make_scene();
-  const infolerp::pinhole_camera cam{.eye = {0.0f, -28.0f, 8.0f}, .target = {0.0f, 0.0f, 0.5f}, .up = {0, 0, 1},
+  const infolerp::pinhole_camera cam{.eye = {0.0f, -19.0f, 5.5f}, .target = {0.0f, 1.0f, 1.0f}, .up = {0, 0, 1},
                                      .vertical_fov_degrees = 55.0f, .width = width, .height = height};
 #ifdef _OPENMP
   infolerp::openmp_executor exec{};
@@ -236,7 +238,7 @@ int pareto_refine(int argc, char** argv) {
     const char* name = infolerp::to_string(criteria[c]);
     bool first = true;
     for (std::size_t budget : budgets) {
-      run_result rr = run(sc, cam, reference, criteria[c], budget, exec);
+      run_result rr = run(sc, cam, reference, criteria[c], budget, s_req, exec);
       const auto& s1 = rr.report.stage1;
       const auto& s2 = rr.report.stage2;
       if (first) {
