@@ -293,7 +293,7 @@ int pareto_refine(int argc, char** argv) {
   const std::string gp = stem + ".gp";
   if (std::FILE* g = std::fopen(gp.c_str(), "w")) {
     std::fprintf(g,
-                 "set terminal pngcairo size 900,600\nset output '%s'\nset datafile separator ','\n"
+                 "set terminal pngcairo noenhanced size 900,600\nset output '%s'\nset datafile separator ','\n"
                  "set key bottom right\nset logscale x\nset xlabel 'shading samples'\nset ylabel 'PSNR (dB)'\n"
                  "set title 'NLD refinement criteria: street scene, %ux%u'\nset grid\n"
                  "plot for [c in 'NLD_OS NLD_IS RND'] '%s' using (strcol(1) eq c ? $3 : 1/0):7 "
