@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include "support/demo_scene.hpp"
 #include "support/image.hpp"
 #include "support/reference_shader.hpp"
@@ -49,11 +50,18 @@ class progress_bar {
   int last_ = -1;
 };
 
+// One line on stderr for a failed status (without the library's "infolerp: " prefix).
+inline void report(const status& s) {
+  std::string_view m = s.message();
+  if (m.starts_with("infolerp: ")) m.remove_prefix(10);
+  std::fprintf(stderr, "infolerp_demo: %.*s\n", static_cast<int>(m.size()), m.data());
+}
+
 // Writes img as DIR/name, reporting failure on stderr. Returns success.
 inline bool save_png(const demo_context& ctx, const support::image& img, const std::string& name) {
   const std::string path = (ctx.options.out_dir / name).string();
   if (auto s = support::write_png(img, path); !s) {
-    std::fprintf(stderr, "infolerp_demo: %s\n", s.message().c_str());
+    report(s);
     return false;
   }
   std::printf("wrote %s\n", path.c_str());

@@ -3,7 +3,8 @@
 // saliency and the I-Buffer upsampler on top of the same context.
 #include <charconv>
 #include <cstdio>
-#include <cstring>
+#include <cstdlib>
+#include <functional>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -42,7 +43,12 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg = argv[i];
     auto value = [&](int k) -> const char* { return i + k < argc ? argv[i + k] : nullptr; };
-    auto need = [&](int k) { return value(k) != nullptr; };
+    // An option's value is there and is not the next option.
+    auto need = [&](int k) {
+      for (int j = 1; j <= k; ++j)
+        if (value(j) == nullptr || std::string_view(value(j)).starts_with("--")) return false;
+      return true;
+    };
     if (arg == "--help" || arg == "-h") {
       std::fputs(usage, stdout);
       std::exit(0);
@@ -78,7 +84,7 @@ bool stage_reference(demo::demo_context& ctx) {
   demo::progress_bar bar("reference");
   auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads, std::ref(bar));
   if (!stats) {
-    std::fprintf(stderr, "infolerp_demo: %s\n", stats.error().message().c_str());
+    demo::report(stats.error());
     return false;
   }
   ctx.reference_stats = *stats;
@@ -104,7 +110,7 @@ int main(int argc, char** argv) {
   const support::embree_device device;
   auto scene = support::make_demo_scene(device, {.mesh_path = options->mesh_path});
   if (!scene) {
-    std::fprintf(stderr, "infolerp_demo: %s\n", scene.error().message().c_str());
+    demo::report(scene.error());
     return 1;
   }
   std::size_t triangles = 0;
