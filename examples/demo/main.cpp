@@ -22,6 +22,7 @@ constexpr const char* usage =
     "  --threads N     worker threads (default: all cores)\n"
     "  --ao N          ambient-occlusion rays per pixel (default 64)\n"
     "  --soft N        soft-shadow rays per pixel toward the area light (default 16)\n"
+    "  --packets       trace each pixel's AO and soft-shadow rays as 16-ray packets\n"
     "  --out DIR       output directory (default infolerp-out)\n"
     "  --help          this text\n";
 
@@ -66,6 +67,8 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
       if (!need(1) || !parse_int(argv[++i], 0, 4096, n))
         return fail(std::string(arg) + " needs an integer in [0, 4096]");
       (arg == "--ao" ? o.shader.ao_rays : o.shader.soft_shadow_rays) = static_cast<unsigned>(n);
+    } else if (arg == "--packets") {
+      o.shader.packets = true;
     } else if (arg == "--out") {
       if (!need(1)) return fail("--out needs a directory");
       o.out_dir = argv[++i];
@@ -79,8 +82,8 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
 // Stage 1: the full per-pixel reference (every pixel evaluated and shaded).
 bool stage_reference(demo::demo_context& ctx) {
   const auto& o = ctx.options;
-  std::printf("reference: %dx%d, AO %u rays, soft shadow %u rays, hard-shadow sun, textures\n", o.width, o.height,
-              o.shader.ao_rays, o.shader.soft_shadow_rays);
+  std::printf("reference: %dx%d, AO %u rays, soft shadow %u rays, hard-shadow sun, textures, %s\n", o.width,
+              o.height, o.shader.ao_rays, o.shader.soft_shadow_rays, o.shader.packets ? "16-ray packets" : "single rays");
   demo::progress_bar bar("reference");
   auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads, std::ref(bar));
   if (!stats) {
