@@ -8,6 +8,8 @@
 // The M light points and N hemisphere directions are fixed sets (Hammersley points; the AO
 // directions cosine-weighted and rotated into each pixel's tangent frame), so evaluating the
 // same pixel twice gives the same bits: no Monte Carlo noise to drown interpolation error.
+// Callers that evaluate from their own threads call enable_flush_to_zero() in each of them, as
+// render_reference does, so that every thread rounds alike.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -82,7 +84,8 @@ struct render_stats {
 };
 
 // Renders every pixel with full evaluation + shade, in parallel over rows (OpenMP, `threads`
-// threads; 0 = OpenMP's default). Each worker sets flush-to-zero. The image is the same bit for
+// threads; 0 = OpenMP's default). Each worker, the calling thread included, is left with
+// flush-to-zero set. The image is the same bit for
 // bit for any thread count. progress(rows_done, rows_total) is called after each row, one call
 // at a time (from worker threads). Errors: width or height not positive.
 result<render_stats> render_reference(const reference_shader& shader, int width, int height, image& out,
