@@ -207,3 +207,18 @@ TEST_CASE("saliency: bad input gets a clear status") {
   point.triangles = {{0, 0, 0}};
   CHECK(infolerp::compute_saliency(point).error().code() == infolerp::errc::degenerate_triangle);
 }
+
+TEST_CASE("saliency: approximate error table", "[.table]") {
+  auto m = infolerp::support::make_icosphere(5);
+  for (auto& p : m.positions) {
+    const float f = 1.0f + 0.03f * std::sin(9.0f * p.x) * std::sin(7.0f * p.y + 1.0f) * std::cos(5.0f * p.z);
+    p *= f;
+  }
+  auto exact = infolerp::compute_saliency(m);
+  for (double cps : {0.5, 1.0, 2.0, 3.0, 4.0, 6.0}) {
+    auto approx = infolerp::compute_saliency(m, {.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = cps});
+    double lv = 0;
+    for (std::size_t i = 0; i < 5; ++i) lv = std::max(lv, relative_l2(approx->levels[i], exact->levels[i]));
+    WARN("cells/sigma " << cps << " saliency rel L2 " << relative_l2(approx->saliency, exact->saliency) << " worst level " << lv);
+  }
+}

@@ -67,7 +67,7 @@ struct saliency_options {
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   saliency_method method = saliency_method::exact;  // exact or approximate
-  double approx_cells_per_sigma = 2.0;             // approximate mode: representative cells per σ (>= 0.5)
+  double approx_cells_per_sigma = 3.0;             // approximate mode: representative cells per σ (>= 0.5)
   std::size_t grain = 1;                           // cells per parallel task (exact) ×256 vertices (approximate)
 };
 
@@ -247,29 +247,47 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
   const std::size_t P = g.x.size(), L = sigma.size();
   std::vector<double> avg(L * P);
   std::vector<glm::dvec3> rep_pos;
-  std::vector<double> rep_sum, rep_count;
+  std::vector<double> rep_sum, rep_count, rep_spread;
   std::vector<std::uint32_t> rep_ids;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   for (std::size_t u = 0; u < L; ++u) {
-    // Representatives: bin the (already sorted) points into cells of size h, in a fine grid.
+    // Representatives: bin the points into cells of size h (sparse: sort by 63-bit cell key).
     const double h = sigma[u] / cells_per_sigma;
-    std::vector<glm::dvec3> pts(P);
-    for (std::size_t k = 0; k < P; ++k) pts[k] = {g.x[k], g.y[k], g.z[k]};
-    std::vector<std::uint32_t> ids(P);
-    for (std::size_t k = 0; k < P; ++k) ids[k] = static_cast<std::uint32_t>(k);
-    const point_grid fine = make_point_grid(pts, g.value, g.weight, ids, h);
-    rep_pos.clear(), rep_sum.clear(), rep_count.clear(), rep_ids.clear();
-    for (std::size_t c = 0; c + 1 < fine.cell_start.size(); ++c) {
-      const std::uint32_t b = fine.cell_start[c], e = fine.cell_start[c + 1];
-      if (b == e) continue;
+    keyed.resize(P);
+    for (std::size_t k = 0; k < P; ++k) {
+      auto q = [&](double p, int axis) {
+        return static_cast<std::uint64_t>(std::min(std::floor((p - g.lo[axis]) / h), 2097151.0));
+      };
+      keyed[k] = {(q(g.x[k], 0) << 42) | (q(g.y[k], 1) << 21) | q(g.z[k], 2), static_cast<std::uint32_t>(k)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    rep_pos.clear(), rep_sum.clear(), rep_count.clear(), rep_ids.clear(), rep_spread.clear();
+    for (std::size_t b = 0; b < P;) {
+      std::size_t e = b;
       glm::dvec3 s(0.0);
       double cs = 0.0;
-      for (std::uint32_t k = b; k < e; ++k) s += glm::dvec3(fine.x[k], fine.y[k], fine.z[k]), cs += fine.value[k];
+      for (; e < P && keyed[e].first == keyed[b].first; ++e) {
+        const std::uint32_t k = keyed[e].second;
+        s += glm::dvec3(g.x[k], g.y[k], g.z[k]), cs += g.value[k];
+      }
       const double cnt = static_cast<double>(e - b);
-      rep_pos.push_back(s / cnt), rep_sum.push_back(cs), rep_count.push_back(cnt);
+      const glm::dvec3 centre = s / cnt;
+      double spread = 0.0;  // RMS distance of the cell's points to their centroid
+      for (std::size_t f = b; f < e; ++f) {
+        const std::uint32_t k = keyed[f].second;
+        const glm::dvec3 d = glm::dvec3(g.x[k], g.y[k], g.z[k]) - centre;
+        spread += glm::dot(d, d);
+      }
+      rep_pos.push_back(centre), rep_sum.push_back(cs), rep_count.push_back(cnt);
+      rep_spread.push_back(std::sqrt(spread / cnt));
       rep_ids.push_back(static_cast<std::uint32_t>(rep_ids.size()));
+      b = e;
     }
-    const point_grid reps = make_point_grid(rep_pos, rep_sum, rep_count, rep_ids, 2.0 * sigma[u]);
+    const point_grid reps = make_point_grid(rep_pos, rep_sum, rep_count, rep_ids, 2.0 * sigma[u] + 1.5 * h);
     const double r2 = 4.0 * sigma[u] * sigma[u], a = 1.0 / (2.0 * sigma[u] * sigma[u]);
+    const double inner = std::max(0.0, 2.0 * sigma[u] - 1.5 * h), outer = 2.0 * sigma[u] + 1.5 * h;
+    const std::vector<double>& reps_spread = rep_spread;
+    const double inner2 = inner * inner, outer2 = outer * outer;
     exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         const double xi = g.x[k], yi = g.y[k], zi = g.z[k];
@@ -282,8 +300,19 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
               for (std::uint32_t j = reps.cell_start[c]; j < reps.cell_start[c + 1]; ++j) {
                 const double dx = reps.x[j] - xi, dy = reps.y[j] - yi, dz = reps.z[j] - zi;
                 const double d2 = dx * dx + dy * dy + dz * dz;
-                if (d2 > r2) continue;
-                const double w = exp_neg2(-d2 * a);
+                if (d2 > outer2) continue;
+                // Soft cutoff: a cell straddling the ball's edge counts with roughly the
+                // fraction of its points inside (a linear ramp of half-width 1.5 × its RMS
+                // spread around 2σ; a single point keeps the hard cutoff).
+                double w = exp_neg2(-std::min(d2, r2) * a);
+                if (d2 > inner2) {
+                  const double ramp = 1.5 * reps_spread[reps.id[j]];
+                  const double dist = std::sqrt(d2);
+                  if (ramp > 0.0)
+                    w *= std::clamp(0.5 + (2.0 * sigma[u] - dist) / (2.0 * ramp), 0.0, 1.0);
+                  else if (d2 > r2)
+                    continue;
+                }
                 num += w * reps.value[j];
                 den += w * reps.weight[j];
               }
