@@ -87,3 +87,31 @@ void BM_Saliency_Approx(benchmark::State& state) {
 BENCHMARK(BM_Saliency_Approx)->DenseRange(4, 24, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
+
+#include "infolerp/saliency/salient_clustering.hpp"
+
+namespace {
+void BM_SalientClustering(benchmark::State& state) {
+  static std::optional<std::pair<infolerp::indexed_mesh, std::vector<double>>> data = []()
+      -> std::optional<std::pair<infolerp::indexed_mesh, std::vector<double>>> {
+    auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("bunny00"));
+    if (!m.ok()) return std::nullopt;
+    auto s = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{2});
+    if (!s.ok()) return std::nullopt;
+    return std::pair{std::move(*m), std::move(s->saliency)};
+  }();
+  if (!data) return state.SkipWithError("bunny00 not found");
+  std::uint32_t iterations = 0;
+  bool converged = false;
+  for (auto _ : state) {
+    auto c = infolerp::salient_clustering(data->first, data->second, {.clusters = 10, .seed = 1});
+    if (!c.ok()) return state.SkipWithError(c.error().message().c_str());
+    iterations = c->iterations;
+    converged = c->converged;
+  }
+  state.counters["triangles"] = static_cast<double>(data->first.triangles.size());
+  state.counters["rounds"] = iterations;
+  state.counters["converged"] = converged ? 1.0 : 0.0;
+}
+BENCHMARK(BM_SalientClustering)->Unit(benchmark::kMillisecond)->UseRealTime();
+}  // namespace
