@@ -79,7 +79,7 @@ std::vector<glm::vec4> poisoned(std::uint32_t w, std::uint32_t h) {
 }
 
 infolerp::upsampler<sample> make(std::uint32_t w, std::uint32_t h, std::uint32_t passes, std::uint32_t max_passes = 5) {
-  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = max_passes});
+  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = max_passes, .keep_ibuffer = true});
   REQUIRE(u.ok());
   return std::move(*u);
 }
@@ -227,7 +227,7 @@ TEST_CASE("cluster, shadow and background boundaries are evaluated, not interpol
     // upsampler, so some pixels near it get interpolated wrong values.
     static_assert(sizeof(flat) < sizeof(sample));
     no_lights nl;
-    auto u = infolerp::upsampler<flat>::create(w, h, {.passes = 4});
+    auto u = infolerp::upsampler<flat>::create(w, h, {.passes = 4, .keep_ibuffer = true});
     REQUIRE(u.ok());
     std::vector<float> out(static_cast<std::size_t>(w) * h);
     REQUIRE(u->render(nl, std::span<float>(out)).ok());
@@ -241,7 +241,7 @@ TEST_CASE("cluster, shadow and background boundaries are evaluated, not interpol
 TEST_CASE("background is never interpolated with geometry, even if compatible() says yes", "[upsample]") {
   careless src;
   static_assert(infolerp::check_sample_source<careless>());
-  auto u = infolerp::upsampler<bg_sample>::create(90, 70, {.passes = 3});
+  auto u = infolerp::upsampler<bg_sample>::create(90, 70, {.passes = 3, .keep_ibuffer = true});
   REQUIRE(u.ok());
   std::vector<float> out(90 * 70);
   REQUIRE(u->render(src, std::span<float>(out)).ok());
@@ -284,9 +284,13 @@ TEST_CASE("any output size: every pixel written, exact on one cluster, bounded o
       const std::uint32_t step = 1u << (passes - 1);
       CHECK(src.max_x.load() < w + step - 1);
       CHECK(src.max_y.load() < h + step - 1);
-      // Memory: about 4/3 of the full-resolution buffer.
+      // Memory: about 4/3 of the full-resolution buffer with the final I-Buffer kept, 1/3 without.
       const double full = static_cast<double>(w) * h;
       CHECK(static_cast<double>(up.pyramid_samples()) <= 4.0 / 3.0 * full + 4.0 * (w + h) + 4.0 * 5);
+      auto lean = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5});
+      REQUIRE(lean.ok());
+      CHECK(static_cast<double>(lean->pyramid_samples()) <= 1.0 / 3.0 * full + 4.0 * (w + h) + 4.0 * 5);
+      CHECK(lean->ibuffer().empty());
       // Per-pass counts add up to the pass size.
       const auto& st = up.stats();
       for (std::uint32_t p = 0; p < st.passes; ++p)

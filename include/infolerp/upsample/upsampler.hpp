@@ -52,6 +52,7 @@ struct upsampler_options {
   std::uint32_t max_passes = 4;     // pyramid depth allocated up front; passes may change up to it without allocating
   std::uint32_t rows_per_task = 4;  // rows of a pass per executor task (the parallel_for grain)
   bool record_kinds = true;         // keep the R/I/E kind of every pixel of the last pass (kinds())
+  bool keep_ibuffer = false;        // keep the last pass's samples (ibuffer()); off: shade straight into the frame
 };
 
 // Statistics of one pass.
@@ -122,8 +123,9 @@ class upsampler {
   // An upsampler for a width×height image, or why not: width or height 0 (errc::empty_input),
   // max_passes outside [1, 16], passes outside [1, max_passes], rows_per_task 0, or a side
   // above 2^24 (errc::bad_parameter).
-  // Allocation: about (4/3)·W·H samples (precisely Σ_d w_d·h_d ≤ 4/3·W·H + 4(W+H) + 4·max_passes
-  // samples with w_d = floor(w_{d−1}/2)+1), plus W·H bytes for kinds and H counters.
+  // Allocation: the coarser passes, about (1/3)·W·H samples (precisely Σ_{d≥1} w_d·h_d ≤
+  // 1/3·W·H + 4(W+H) + 4·max_passes samples with w_0 = W, w_d = floor(w_{d−1}/2)+1), plus W·H
+  // more with keep_ibuffer, W·H bytes with record_kinds, and H row counters.
   [[nodiscard]] static result<upsampler> create(std::uint32_t width, std::uint32_t height,
                                                 upsampler_options options = {}) {
     upsampler u;
@@ -152,7 +154,8 @@ class upsampler {
     std::uint32_t w = width, h = height;
     for (std::uint32_t d = 0; d < options_.max_passes; ++d) {
       extents_[d] = {w, h};
-      levels_[d].assign(static_cast<std::size_t>(w) * h, Sample{});
+      const bool stored = d > 0 || options_.keep_ibuffer;
+      levels_[d].assign(stored ? static_cast<std::size_t>(w) * h : 0, Sample{});
       w = detail::coarser_extent(w);
       h = detail::coarser_extent(h);
     }
@@ -237,7 +240,8 @@ class upsampler {
   [[nodiscard]] const upsampler_options& options() const noexcept { return options_; }
   // Statistics of the last render.
   [[nodiscard]] const upsample_stats& stats() const noexcept { return stats_; }
-  // The final I-Buffer of the last render (width·height samples, row-major).
+  // The final I-Buffer of the last render (width·height samples, row-major); empty unless
+  // options.keep_ibuffer.
   [[nodiscard]] std::span<const Sample> ibuffer() const noexcept { return levels_[0]; }
   // R/I/E kind of each pixel in the last pass of the last render (empty unless record_kinds).
   [[nodiscard]] std::span<const sample_kind> kinds() const noexcept { return kinds_; }
@@ -276,6 +280,7 @@ class upsampler {
     if (d == 0) {
       out[idx] = src.shade(s, i, j);
       if (!kinds_.empty()) kinds_[idx] = kind;
+      if (!options_.keep_ibuffer) return;
     }
     levels_[d][idx] = std::move(s);
   }
