@@ -13,6 +13,8 @@
 //                     of cluster ids
 //   ibuffer           the I-Buffer, 1-5 passes, several clusterings (STAND-IN clusterings, see
 //                     tests/support/demo_upsample.hpp, until include/infolerp/cluster lands)
+//   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
+//                     difference (§4.1's extension to other high-frequency signals)
 // Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim)
 // and FILE.png: PSNR against time (gnuplot), with FILE.gp/FILE.dat next to it.
 #include <algorithm>
@@ -87,6 +89,17 @@ struct contrast_source {
   glm::vec3 shade(const contrast_sample& c, std::uint32_t x, std::uint32_t y) const { return base.shade(c.s, x, y); }
 };
 
+// The I-Buffer with the occlusion terms in the compatibility test as well (the §4.1 extension
+// to "other high frequency signals"): same cluster, same light bits, and AO and soft-shadow
+// ratios within `tolerance`.
+struct occlusion_checked_source : sup::demo_ibuffer_source {
+  float tolerance = 0.1f;
+  bool compatible(const sample& a, const sample& b) const {
+    return infolerp::compatible(a, b) && std::abs(a.occlusion[0] - b.occlusion[0]) <= tolerance &&
+           std::abs(a.occlusion[1] - b.occlusion[1]) <= tolerance;
+  }
+};
+
 class harness {
  public:
   harness(const sup::demo_scene& scene, const sup::shader_options& shading, int width, int height, int threads)
@@ -126,6 +139,18 @@ class harness {
                                    c.name + " (" + std::to_string(c.count()) + " clusters), " + std::to_string(passes) + " passes", f))
           return 1;
         if (c.name == "normal2") matched_fraction[passes] = f;
+      }
+    }
+    // (6b) the I-Buffer with the occlusion terms also tested.
+    for (float tolerance : {0.05f, 0.1f}) {
+      for (std::uint32_t passes = 3; passes <= 5; ++passes) {
+        occlusion_checked_source src;
+        static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusterings[2], w_, h_};
+        src.tolerance = tolerance;
+        double f = 0;
+        char setting[96];
+        std::snprintf(setting, sizeof setting, "normal2 + |dAO|,|dsoft| <= %.2f, %u passes", static_cast<double>(tolerance), passes);
+        if (!run_upsampler<sample>(src, passes, "ibuffer_occl", setting, f)) return 1;
       }
     }
     // (5) the same schedule deciding by luminance contrast.
@@ -293,7 +318,7 @@ class harness {
     // Plot: PSNR (capped at 60 dB for the exact methods) against seconds, one series per method.
     const std::string base = csv_path.size() > 4 && csv_path.ends_with(".csv") ? csv_path.substr(0, csv_path.size() - 4) : csv_path;
     std::ofstream dat(base + ".dat");
-    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer"};
+    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer", "ibuffer_occl"};
     for (const char* m : methods) {
       dat << "# " << m << "\n";
       for (const auto& r : rows_)
@@ -302,12 +327,12 @@ class harness {
     }
     dat.close();
     std::ofstream gp(base + ".gp");
-    gp << "set terminal pngcairo size 1000,650\nset output '" << base << ".png'\n"
+    gp << "set terminal pngcairo size 1000,650 noenhanced\nset output '" << base << ".png'\n"
        << "set title 'Demo scene " << w_ << "x" << h_ << ": PSNR against render time (exact methods drawn at 60 dB)'\n"
        << "set xlabel 'seconds (log)'\nset ylabel 'PSNR dB vs full per-pixel evaluation'\nset logscale x\nset grid\n"
        << "set key bottom right\nplot ";
-    for (int i = 0; i < 6; ++i)
-      gp << (i ? ", " : "") << "'" << base << ".dat' index " << i << " using 1:2 with linespoints pt " << (i + 4)
+    for (int i = 0; i < 7; ++i)
+      gp << (i ? ", " : "") << "'" << base << ".dat' index " << i << " using 1:2 with points pt " << (i + 4)
          << " title '" << methods[i] << "'";
     gp << "\n";
     gp.close();
