@@ -1,19 +1,17 @@
-// infolerp_pareto SUBCOMMAND [options]: time-versus-error experiments, one per subcommand.
+// infolerp_pareto SUBCOMMAND [options]: dispatches to the time-against-error harnesses.
 #include <cstdio>
 #include <cstring>
 #include "pareto.hpp"
 
 int main(int argc, char** argv) {
+  using sub_fn = int (*)(int, char**);
   struct sub {
     const char* name;
-    int (*run)(int, char**);
+    sub_fn fn;
   };
-  const sub subs[] = {{"refine", pareto_refine}, {"upsample", pareto_upsample}};
+  const sub subs[] = {{"refine", &pareto_refine}, {"upsample", &pareto_upsample}};
   for (const sub& s : subs)
-    if (argc >= 2 && std::strcmp(argv[1], s.name) == 0 && s.run != nullptr) return s.run(argc - 1, argv + 1);
-  std::fprintf(stderr, "usage: %s SUBCOMMAND --csv FILE\nsubcommands:", argv[0]);
-  for (const sub& s : subs)
-    if (s.run != nullptr) std::fprintf(stderr, " %s", s.name);
-  std::fprintf(stderr, "\n");
+    if (argc >= 2 && std::strcmp(argv[1], s.name) == 0 && s.fn != nullptr) return s.fn(argc - 1, argv + 1);
+  std::fprintf(stderr, "usage: infolerp_pareto refine|upsample [options]\n");
   return 2;
 }

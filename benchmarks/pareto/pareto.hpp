@@ -1,5 +1,5 @@
 #pragma once
-// Subcommands of build/benchmarks/infolerp_pareto, one per file benchmarks/pareto/<sub>.cpp.
-// Declared weak so the binary links while only some of them exist; main() skips absent ones.
-[[gnu::weak]] int pareto_refine(int argc, char** argv);    // refine.cpp: NLD_OS / NLD_IS / RND (issue 5)
-[[gnu::weak]] int pareto_upsample(int argc, char** argv);  // upsample.cpp: I-Buffer upsampler
+// Subcommands of infolerp_pareto, the time-against-error harness: each lives in its own
+// benchmarks/pareto/<sub>.cpp. Weak, so that the binary links while a subcommand's file is absent.
+[[gnu::weak]] int pareto_refine(int argc, char** argv);
+[[gnu::weak]] int pareto_upsample(int argc, char** argv);

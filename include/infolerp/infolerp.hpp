@@ -8,3 +8,6 @@
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/upsample/sample_source.hpp"
+#include "infolerp/upsample/upsampler.hpp"
+#include "infolerp/upsample/pass_controller.hpp"
