@@ -9,8 +9,9 @@
 //
 // CSV: criterion,stage,shading_samples,triangles,triangles_total,seconds,psnr_db
 // (stage 1: initial geometry shaded; stage 2: refinement stopped by the budget or the rule).
-// The tracer is a brute-force one (the scene has ~150 triangles); the Embree tracer and the
-// reference shader of tests/support can replace brute_force_scene when they land.
+// Tracing: Embree 3 (tests/support/embree_tracer.hpp). Shading: Lambert with a hard sun
+// shadow ray and a sky term (support::reference_shader is tied to the demo scene's textured,
+// multi-object layout, so this scene keeps its own shader of the same style).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,12 +19,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/core/executor.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "pareto.hpp"
+#include "support/embree_tracer.hpp"
 #include "support/procedural.hpp"
 
 namespace {
@@ -52,31 +55,11 @@ struct scene {
   std::vector<glm::vec3> normal;  // per triangle
   glm::vec3 to_sun = glm::normalize(glm::vec3(0.55f, 0.75f, 0.45f));
 
-  // Brute force with a per-box bounding-box test would be faster; ~150 triangles is cheap enough.
-  infolerp::hit intersect(const infolerp::ray& r) const {
-    infolerp::hit best;
-    best.distance = r.tfar;
-    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      const glm::vec3 a = mesh.positions[mesh.triangles[t].x], b = mesh.positions[mesh.triangles[t].y],
-                      c = mesh.positions[mesh.triangles[t].z];
-      const glm::vec3 e1 = b - a, e2 = c - a, pv = glm::cross(r.direction, e2);
-      const float det = glm::dot(e1, pv);
-      if (std::abs(det) < 1e-12f) continue;
-      const float inv = 1.0f / det;
-      const glm::vec3 tv = r.origin - a;
-      const float u = glm::dot(tv, pv) * inv;
-      if (u < 0.0f || u > 1.0f) continue;
-      const glm::vec3 qv = glm::cross(tv, e1);
-      const float v = glm::dot(r.direction, qv) * inv;
-      if (v < 0.0f || u + v > 1.0f) continue;
-      const float d = glm::dot(e2, qv) * inv;
-      if (d < r.tnear || d >= best.distance) continue;
-      best = {0, t, {u, v}, d};
-    }
-    if (!best.valid()) best.distance = std::numeric_limits<float>::infinity();
-    return best;
-  }
-  bool occluded(const infolerp::ray& r) const { return intersect(r).valid(); }
+  // Traced with Embree 3 (tests/support/embree_tracer.hpp); built by make_scene().
+  std::unique_ptr<infolerp::support::embree_device> device;
+  std::unique_ptr<infolerp::support::embree_scene> tracer;
+  infolerp::hit intersect(const infolerp::ray& r) const { return tracer->intersect(r); }
+  bool occluded(const infolerp::ray& r) const { return tracer->occluded(r); }
 
   // Lambert with a hard sun shadow and a constant sky term: the reference-style shader.
   glm::vec3 shade(glm::vec3 p, std::uint32_t t) const {
@@ -84,6 +67,7 @@ struct scene {
     const float cosine = glm::dot(n, to_sun);
     float sun = 0.0f;
     if (cosine > 0.0f) {
+      infolerp::support::enable_flush_to_zero();  // every thread traces alike (embree_tracer.hpp)
       infolerp::ray sr;
       sr.origin = p + 1e-3f * n;
       sr.direction = to_sun;
@@ -114,6 +98,12 @@ scene make_scene() {
                                                  s.mesh.positions[t.z] - s.mesh.positions[t.x])));
   // The sun is behind the portico, so its shadows fall into the street toward the viewer.
   s.to_sun = glm::normalize(glm::vec3(-0.4f, 0.55f, 0.5f));
+  s.device = std::make_unique<infolerp::support::embree_device>();
+  s.tracer = std::make_unique<infolerp::support::embree_scene>(*s.device);
+  if (!s.tracer->add_mesh(s.mesh).ok() || !s.tracer->commit().ok()) {
+    std::fprintf(stderr, "embree scene build failed\n");
+    std::exit(1);
+  }
   return s;
 }
 
@@ -167,7 +157,7 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   const std::size_t n = std::size_t(cam.width) * cam.height;
   out.image1.resize(n);
   out.image2.resize(n);
-  if (auto st = r->start(sc, cam, shade, exec); !st) {
+  if (auto st = r->start(*sc.tracer, cam, shade, exec); !st) {
     std::fprintf(stderr, "%s\n", st.message().c_str());
     std::exit(1);
   }
@@ -213,6 +203,7 @@ int pareto_refine(int argc, char** argv) {
   // Per-pixel reference: the shader at every pixel's primary hit.
   std::vector<glm::vec3> reference(std::size_t(width) * height, glm::vec3(0.0f));
   exec.parallel_for(reference.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    infolerp::support::enable_flush_to_zero();
     for (std::size_t p = begin; p < end; ++p) {
       const infolerp::ray r = cam.primary_ray(static_cast<std::uint32_t>(p % width), static_cast<std::uint32_t>(p / width));
       const infolerp::hit h = sc.intersect(r);
