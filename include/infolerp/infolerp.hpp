@@ -7,4 +7,7 @@
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/mesh/validate.hpp"
+#include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/log2.hpp"

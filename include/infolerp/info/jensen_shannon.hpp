@@ -128,19 +128,20 @@ double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p 
 struct distribution_scale {
   double pre = 1.0, inv = 1.0;
 };
+// `what` names the entry point in messages ("jensen_shannon", "entropy", ...).
 template <class T>
-result<distribution_scale> check_distribution(std::span<const T> x, const char* name, std::size_t index) {
+result<distribution_scale> check_distribution(std::span<const T> x, const char* what, const char* name, std::size_t index) {
   const auto label = [&] { return index == no_element ? std::string(name) : std::string(name) + " " + std::to_string(index); };
-  if (x.empty()) return make_error(errc::empty_input, no_element, "jensen_shannon: ", label(), " has no bins");
+  if (x.empty()) return make_error(errc::empty_input, no_element, what, ": ", label(), " has no bins");
   double sum = 0.0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     const double v = static_cast<double>(x[i]);
-    if (!std::isfinite(v)) return make_error(errc::non_finite, i, "jensen_shannon: ", label(), " bin ", i, ": non-finite entry");
-    if (v < 0.0) return make_error(errc::bad_distribution, i, "jensen_shannon: ", label(), " bin ", i, ": negative entry ", v);
+    if (!std::isfinite(v)) return make_error(errc::non_finite, i, what, ": ", label(), " bin ", i, ": non-finite entry");
+    if (v < 0.0) return make_error(errc::bad_distribution, i, what, ": ", label(), " bin ", i, ": negative entry ", v);
     sum += v;
   }
   if (!(sum > 0.0))
-    return make_error(errc::bad_distribution, no_element, "jensen_shannon: ", label(), ": all ", x.size(),
+    return make_error(errc::bad_distribution, no_element, what, ": ", label(), ": all ", x.size(),
                       " bins are zero (no distribution to normalise)");
   distribution_scale s;
   if (!std::isfinite(sum) || sum < 0x1p-1000) {  // rescale by a power of two (exact) first
@@ -184,9 +185,9 @@ result<double> jensen_shannon_checked(std::span<const T> p, std::span<const T> q
     return make_error(errc::bad_parameter, no_element, "jensen_shannon: weight_p ", weight_p, " outside [0, 1]");
   if (p.size() != q.size())
     return make_error(errc::bad_distribution, no_element, "jensen_shannon: p has ", p.size(), " bins but q has ", q.size());
-  auto sp = check_distribution(p, "p", no_element);
+  auto sp = check_distribution(p, "jensen_shannon", "p", no_element);
   if (!sp) return sp.error();
-  auto sq = check_distribution(q, "q", no_element);
+  auto sq = check_distribution(q, "jensen_shannon", "q", no_element);
   if (!sq) return sq.error();
   return js_kernel<true>(p.data(), q.data(), p.size(), weight_p, sp->pre, sp->inv, sq->pre, sq->inv);
 }
@@ -238,7 +239,7 @@ inline result<double> jensen_shannon(std::span<const std::span<const double>> di
     if (distributions[i].size() != bins)
       return make_error(errc::bad_distribution, i, "jensen_shannon: distribution ", i, " has ", distributions[i].size(),
                         " bins, distribution 0 has ", bins);
-    auto s = detail::check_distribution(distributions[i], "distribution", i);
+    auto s = detail::check_distribution(distributions[i], "jensen_shannon", "distribution", i);
     if (!s) return s.error();
     inputs[i] = {*s, weights[i] / weight_sum};
   }
