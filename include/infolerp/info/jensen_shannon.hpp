@@ -246,8 +246,13 @@ inline result<double> jensen_shannon(std::span<const std::span<const double>> di
   const auto entry = [&](std::size_t i, std::size_t y) { return distributions[i][y] * inputs[i].scale.pre * inputs[i].scale.inv; };
   double sum = 0.0;
   for (std::size_t y = 0; y < bins; ++y) {
-    double m = 0.0;
-    for (std::size_t i = 0; i < k; ++i) m += inputs[i].weight * entry(i, y);
+    double m = 0.0, lo = entry(0, y), hi = lo;
+    for (std::size_t i = 0; i < k; ++i) {
+      m += inputs[i].weight * entry(i, y);
+      lo = std::min(lo, entry(i, y));
+      hi = std::max(hi, entry(i, y));
+    }
+    if (lo == hi) continue;  // all alike: contributes exactly 0 (identical inputs give 0)
     for (std::size_t i = 0; i < k; ++i) {
       const double x = entry(i, y);
       if (x > 0.0 && inputs[i].weight > 0.0 && x != m) sum += inputs[i].weight * x * detail::log2_accurate(x / m);
