@@ -10,8 +10,9 @@
 //      (of vertices some triangle uses, found in triangle order; with check_unused_vertices,
 //      of every vertex, found in vertex order)
 //   4. repeated index or zero area    errc::degenerate_triangle  element() = triangle
-//   5. edge on more than 2 triangles  errc::non_manifold_edge    element() = the edge's third
-//      triangle (faces ascending); the message names the edge's vertices and its triangles
+//   5. edge on more than 2 distinct   errc::non_manifold_edge    element() = the edge's third
+//      triangles                                                 triangle (ascending); the message
+//                                                                names the edge's vertices and triangles
 // Index counts that are not a multiple of 3 are caught where raw indices enter
 // (make_strided_mesh_view); a mesh type always yields whole triangles.
 #include <cmath>
@@ -82,11 +83,18 @@ status validate_mesh(const M& m, const validate_options& options = {}) {
     if (!topo) return topo.error();
     for (std::size_t e = 0; e < topo->edge_count(); ++e) {
       if (!topo->is_non_manifold_edge(e)) continue;
-      const auto faces = topo->faces_of_edge(e);
+      // Distinct triangles: a degenerate triangle (a, b, a) lists its edge (a, b) twice.
+      const auto faces = topo->faces_of_edge(e);  // ascending
       std::string list;
-      for (std::size_t i = 0; i < faces.size(); ++i) list += (i ? ", " : "") + std::to_string(faces[i]);
-      return make_error(errc::non_manifold_edge, faces[2], "validate_mesh: triangle ", faces[2], ": edge (",
-                        topo->edges[e].x, ", ", topo->edges[e].y, ") is shared by ", faces.size(), " triangles (", list, ")");
+      std::size_t distinct = 0, third = 0;
+      for (std::size_t i = 0; i < faces.size(); ++i) {
+        if (i > 0 && faces[i] == faces[i - 1]) continue;
+        if (++distinct == 3) third = faces[i];
+        list += (distinct > 1 ? ", " : "") + std::to_string(faces[i]);
+      }
+      if (distinct <= 2) continue;
+      return make_error(errc::non_manifold_edge, third, "validate_mesh: triangle ", third, ": edge (", topo->edges[e].x,
+                        ", ", topo->edges[e].y, ") is shared by ", distinct, " triangles (", list, ")");
     }
   }
   return {};
