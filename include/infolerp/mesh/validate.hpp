@@ -83,16 +83,10 @@ status validate_mesh(const M& m, const validate_options& options = {}) {
     if (!topo) return topo.error();
     for (std::size_t e = 0; e < topo->edge_count(); ++e) {
       if (!topo->is_non_manifold_edge(e)) continue;
-      // Distinct triangles: a degenerate triangle (a, b, a) lists its edge (a, b) twice.
-      const auto faces = topo->faces_of_edge(e);  // ascending
+      const auto faces = topo->faces_of_edge(e);  // ascending, each triangle once
       std::string list;
-      std::size_t distinct = 0, third = 0;
-      for (std::size_t i = 0; i < faces.size(); ++i) {
-        if (i > 0 && faces[i] == faces[i - 1]) continue;
-        if (++distinct == 3) third = faces[i];
-        list += (distinct > 1 ? ", " : "") + std::to_string(faces[i]);
-      }
-      if (distinct <= 2) continue;
+      for (std::size_t i = 0; i < faces.size(); ++i) list += (i > 0 ? ", " : "") + std::to_string(faces[i]);
+      const std::size_t third = faces[2], distinct = faces.size();
       return make_error(errc::non_manifold_edge, third, "validate_mesh: triangle ", third, ": edge (", topo->edges[e].x,
                         ", ", topo->edges[e].y, ") is shared by ", distinct, " triangles (", list, ")");
     }
