@@ -2,11 +2,16 @@
 // What the demo's stages share. main.cpp parses the options, builds the scene and renders the
 // per-pixel reference; later stages (clusters, saliency, upsampler) are functions taking a
 // demo_context, declared in examples/demo/stage_<name>.hpp and called from main.cpp in order.
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <glm/geometric.hpp>
 #include "support/demo_scene.hpp"
+#include "support/embree_tracer.hpp"
 #include "support/image.hpp"
 #include "support/reference_shader.hpp"
 
@@ -66,6 +71,33 @@ inline bool save_png(const demo_context& ctx, const support::image& img, const s
   }
   std::printf("wrote %s\n", path.c_str());
   return true;
+}
+
+// An image of the scene coloured per surface point: colour(geometry, triangle, barycentric) for
+// each primary hit, dimmed by a headlight term so shapes stay readable; sky pixels are black.
+// Used by the clusters and saliency stages. Parallel over rows (OpenMP).
+inline support::image render_false_colour(
+    const demo_context& ctx, const std::function<glm::vec3(std::uint32_t, std::uint32_t, glm::vec2)>& colour) {
+  const int w = ctx.options.width, h = ctx.options.height;
+  support::image img(w, h);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int y = 0; y < h; ++y) {
+    support::enable_flush_to_zero();
+    for (int x = 0; x < w; ++x) {
+      const ray r = ctx.scene.view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w, h);
+      const hit hh = ctx.scene.tracer.intersect(r);
+      glm::vec3 c(0.0f);
+      if (hh.valid()) {
+        const auto& m = ctx.scene.objects[hh.geometry].mesh;
+        const glm::uvec3 t = m.triangles[hh.triangle];
+        const glm::vec3 n = glm::normalize(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+        const float light = 0.35f + 0.65f * std::abs(glm::dot(n, r.direction));
+        c = light * colour(hh.geometry, hh.triangle, hh.barycentric);
+      }
+      img.at(x, y) = c;
+    }
+  }
+  return img;
 }
 
 }  // namespace infolerp::demo

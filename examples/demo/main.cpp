@@ -9,6 +9,8 @@
 #include <string_view>
 #include <system_error>
 #include "demo.hpp"
+#include "stage_saliency.hpp"
+#include "stage_upsample.hpp"
 
 namespace demo = infolerp::demo;
 namespace support = infolerp::support;
@@ -123,5 +125,7 @@ int main(int argc, char** argv) {
   const support::reference_shader shader(*scene, options->shader);
   demo::demo_context ctx{*options, *scene, shader, {}, {}};
   if (!stage_reference(ctx)) return 1;
+  if (!demo::stage_saliency(ctx)) return 1;
+  if (!demo::stage_upsample(ctx)) return 1;
   return 0;
 }
