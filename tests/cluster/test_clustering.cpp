@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -315,4 +316,46 @@ TEST_CASE("real meshes: coverage, connectivity, sharp features", "[cluster][real
     REQUIRE(r->cluster_count > 1);
     REQUIRE(r->cluster_count < m->triangles.size() / 10);
   }
+}
+
+TEST_CASE("boundary smoothing straightens a jagged boundary and never touches a third cluster", "[cluster][smoothing]") {
+  const auto m = support::make_plane(12, 12, 2.0f);
+  const std::size_t n = m.triangles.size();
+  std::vector<std::uint32_t> all(n), scratch(n, invalid_id);
+  std::iota(all.begin(), all.end(), 0u);
+  auto topo = build_topology(m);
+  REQUIRE(topo.ok());
+  const element_graph g = subset_graph(*topo, all, scratch);
+  // A 1-D feature (the centroid's x) as a stretch-like channel: JS grows with |Δx|.
+  std::vector<double> x(n);
+  std::vector<glm::dvec3> c(n);
+  for (std::size_t t = 0; t < n; ++t) x[t] = (c[t] = triangle_centroid(corners(m, t))).x;
+  const auto s = make_stretch_state(x, 0);
+  // A: x < 0 plus teeth into x < 0.45 on every other row; C: a corner; B: the rest.
+  region_growing_result r;
+  r.cluster_of.resize(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const bool tooth = static_cast<int>((c[t].y + 1.0) * 6.0) % 2 == 0 && c[t].x < 0.45;
+    r.cluster_of[t] = (c[t].x > 0.65 && c[t].y > 0.65) ? 2u : (c[t].x < 0.0 || tooth) ? 0u : 1u;
+  }
+  auto nearest = [&](double px, double py) {
+    std::uint32_t best = 0;
+    for (std::uint32_t t = 0; t < n; ++t)
+      if (std::hypot(c[t].x - px, c[t].y - py) < std::hypot(c[best].x - px, c[best].y - py)) best = t;
+    return best;
+  };
+  r.seeds = {nearest(-0.9, 0.0), nearest(0.3, -0.5), nearest(0.9, 0.9)};
+  const auto before = r.cluster_of;
+  auto boundary_length = [&](const std::vector<std::uint32_t>& l) {
+    std::size_t e = 0;
+    for (std::uint32_t t = 0; t < n; ++t)
+      for (std::uint32_t u : g.neighbours_of(t)) e += (l[t] == 0 && l[u] == 1) ? 1 : 0;
+    return e;
+  };
+  const std::uint32_t moved = smooth_boundaries(s, g, m, all, 0.5, r);
+  REQUIRE(moved > 0);
+  REQUIRE(boundary_length(r.cluster_of) < boundary_length(before));
+  for (std::size_t t = 0; t < n; ++t) REQUIRE((before[t] == 2) == (r.cluster_of[t] == 2));
+  mesh_clustering mc{r.cluster_of, 3, {}};
+  check_invariants(m, mc);
 }
