@@ -214,3 +214,23 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
   auto p2 = opts.prepare(scene, *topo, tracer, exec);
   REQUIRE(p2->visible == p->visible);
 }
+
+TEST_CASE("stretch binned rows approach exact rows as K grows", "[cluster][stretch]") {
+  const auto m = support::make_uv_sphere(24, 16);
+  const auto raw = texture_stretch(m);
+  REQUIRE(raw.ok());
+  const auto exact = make_stretch_state(*raw, 0);
+  double previous = 1.0;
+  for (std::uint32_t bins : {64u, 1024u, 16384u, 1u << 20}) {
+    const auto binned = make_stretch_state(*raw, bins);
+    double worst = 0.0;
+    for (std::uint32_t a = 0; a < raw->size(); a += 3)
+      for (std::uint32_t b = 0; b < raw->size(); b += 5)
+        worst = std::max(worst, std::abs(binned.divergence(binned.class_of(a), binned.class_of(b)) -
+                                         exact.divergence(exact.class_of(a), exact.class_of(b))));
+    INFO("bins " << bins << " worst |ΔJS| " << worst);
+    REQUIRE(worst <= previous);
+    previous = worst;
+  }
+  REQUIRE(previous < 1e-4);
+}

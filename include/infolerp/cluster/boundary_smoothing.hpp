@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <queue>
 #include <span>
@@ -52,8 +53,8 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
-// Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(band ·
-// log band) plus a flood fill of A ∪ B; divergences only for triangles next to the band.
+// Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
+// plus O(band · log band); divergences only for the boundary and band triangles.
 // Allocation O(M).
 template <class S, class M>
 std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
@@ -74,14 +75,20 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
 
+  // Elements of each cluster (kept up to date as pairs are smoothed).
+  std::vector<std::vector<std::uint32_t>> members_of(k);
+  for (std::uint32_t i = 0; i < n; ++i) members_of[label[i]].push_back(i);
+
   std::uint32_t moved = 0;
-  std::vector<std::uint32_t> region(n, invalid_id), stack;
+  std::vector<std::uint32_t> region(n, invalid_id), stack, members;
   for (const auto& [ca, cb] : pairs) {
+    members.clear();
+    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
+               std::back_inserter(members));
     // 1. Boundary edges and the triangles on them.
     std::vector<std::uint64_t> boundary;
     std::vector<std::uint32_t> frontier;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (label[i] != ca && label[i] != cb) continue;
+    for (std::uint32_t i : members) {
       const std::uint32_t other = label[i] == ca ? cb : ca;
       bool on = false;
       for (std::uint32_t j : g.neighbours_of(i)) {
@@ -203,9 +210,6 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (path == boundary) continue;
 
     // 4. Split A ∪ B along the path.
-    std::vector<std::uint32_t> members;
-    for (std::uint32_t i = 0; i < n; ++i)
-      if (label[i] == ca || label[i] == cb) members.push_back(i);
     std::uint32_t regions = 0;
     for (std::uint32_t i : members) {
       if (region[i] != invalid_id) continue;
@@ -234,6 +238,9 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
           ++moved;
         }
       }
+      members_of[ca].clear();
+      members_of[cb].clear();
+      for (std::uint32_t i : members) members_of[label[i]].push_back(i);
     }
     for (std::uint32_t i : members) region[i] = invalid_id;
   }
