@@ -81,7 +81,13 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
 
   std::uint32_t moved = 0;
   std::vector<std::uint32_t> region(n, invalid_id), stack, members;
+  // JS to the pair's two seeds, memoised per class for the current pair.
+  const std::size_t u = s.class_count();
+  std::vector<double> js_a(u), js_b(u);
+  std::vector<std::uint32_t> stamp(u, invalid_id);
+  std::uint32_t pair_index = 0;
   for (const auto& [ca, cb] : pairs) {
+    ++pair_index;
     members.clear();
     std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
                std::back_inserter(members));
@@ -128,8 +134,13 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     // 2. The band.
     const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
     auto prefers_other = [&](std::uint32_t i) {
-      const double da = s.divergence(s.class_of(i), seed_a), db = s.divergence(s.class_of(i), seed_b);
-      return label[i] == ca ? db < da : da < db;
+      const std::uint32_t c = s.class_of(i);
+      if (stamp[c] != pair_index) {
+        stamp[c] = pair_index;
+        js_a[c] = s.divergence(c, seed_a);
+        js_b[c] = s.divergence(c, seed_b);
+      }
+      return label[i] == ca ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
     };
     std::vector<std::uint8_t> in_band(n, 0);
     std::vector<std::uint32_t> band;
