@@ -68,13 +68,16 @@ concept clustering_channel =
 
 namespace detail {
 
-// Validates positions: every vertex a triangle uses must be finite.
+// Validates indices and positions: every vertex a triangle uses must exist and be finite.
 template <class M>
 status check_positions(const M& m) {
-  const std::size_t nt = mesh_triangle_count(m);
+  const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
   for (std::size_t t = 0; t < nt; ++t) {
     const glm::uvec3 tri = mesh_triangle(m, t);
     for (int c = 0; c < 3; ++c) {
+      if (tri[c] >= nv)
+        return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
+                          " out of range (vertex count ", nv, ")");
       const glm::vec3 p = mesh_position(m, tri[c]);
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         return make_error(errc::non_finite, tri[c], "triangle ", t, ": vertex ", tri[c], " has a non-finite position");
