@@ -82,6 +82,12 @@ TEST_CASE("degenerate and bad triangles") {
   REQUIRE(topo.ok());
   CHECK(topo->triangle_edges[3 * 1 + 0] == infolerp::invalid_id);
   CHECK(topo->neighbours_of(1).size() == 1);
+  // Triangle 1 has edge (0, 1) twice (corners 1 and 2): it is listed once, so the edge is manifold.
+  const std::uint32_t e01 = topo->triangle_edges[3 * 1 + 1];
+  REQUIRE(e01 == topo->triangle_edges[3 * 1 + 2]);
+  const auto faces = topo->faces_of_edge(e01);
+  CHECK(std::vector<std::uint32_t>(faces.begin(), faces.end()) == std::vector<std::uint32_t>{0, 1});
+  CHECK_FALSE(topo->is_non_manifold_edge(e01));
   m.triangles.push_back({0, 1, 3});
   auto bad = infolerp::build_topology(m);
   REQUIRE_FALSE(bad.ok());

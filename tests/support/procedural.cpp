@@ -72,9 +72,12 @@ indexed_mesh make_uv_sphere(unsigned slices, unsigned stacks, float radius) {
   for (unsigned i = 0; i <= stacks; ++i) {
     const float theta = pi * static_cast<float>(i) / static_cast<float>(stacks);
     for (unsigned j = 0; j <= slices; ++j) {
-      const float phi = 2.0f * pi * static_cast<float>(j) / static_cast<float>(slices);
-      m.positions.push_back(radius * glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                               std::cos(theta)));
+      // The seam column repeats column 0 and the poles repeat one point, bit for bit, so that
+      // weld_positions can join them (float sin(π) and cos(2π) are not exact).
+      const float phi = 2.0f * pi * static_cast<float>(j % slices) / static_cast<float>(slices);
+      const bool pole = i == 0 || i == stacks;
+      const float s = pole ? 0.0f : std::sin(theta), c = i == 0 ? 1.0f : i == stacks ? -1.0f : std::cos(theta);
+      m.positions.push_back(radius * glm::vec3(s * std::cos(phi), s * std::sin(phi), c));
       uv.push_back({static_cast<float>(j) / static_cast<float>(slices), static_cast<float>(i) / static_cast<float>(stacks)});
     }
   }
@@ -138,4 +141,23 @@ void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m) {
   dst.normals.clear();
 }
 
+}  // namespace infolerp::support
+
+namespace infolerp::support {
+indexed_mesh weld_positions(const indexed_mesh& m, std::vector<std::uint32_t>& remap) {
+  auto less = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::map<glm::vec3, std::uint32_t, decltype(less)> index(less);
+  indexed_mesh out;
+  remap.resize(m.positions.size());
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    const auto [it, added] = index.emplace(m.positions[v], static_cast<std::uint32_t>(out.positions.size()));
+    if (added) out.positions.push_back(m.positions[v]);
+    remap[v] = it->second;
+  }
+  for (const auto& t : m.triangles) out.triangles.push_back({remap[t.x], remap[t.y], remap[t.z]});
+  out.texcoords = m.texcoords;
+  return out;
+}
 }  // namespace infolerp::support

@@ -21,3 +21,10 @@ indexed_mesh make_box(glm::vec3 lo, glm::vec3 hi);
 void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m = glm::mat4(1.0f));
 
 }  // namespace infolerp::support
+
+namespace infolerp::support {
+// Merges vertices at identical positions (UV seams, repeated poles) so that curvature and
+// saliency see one connected surface. remap[v] is the welded index of original vertex v.
+// Texcoords (per corner) are kept; normals are dropped. O(V log V).
+indexed_mesh weld_positions(const indexed_mesh& m, std::vector<std::uint32_t>& remap);
+}  // namespace infolerp::support

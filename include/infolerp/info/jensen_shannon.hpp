@@ -1,40 +1,169 @@
 #pragma once
-// Jensen–Shannon divergence in bits (Lin 1991; clustering paper §3.1, JS and JS(Y|a,b)).
+// Jensen–Shannon divergence in bits (Lin 1991; clustering paper §3.1: JS(π₁..π_n; p₁..p_n) and
+// the two-row shorthand JS(Y|a,b) with π = p(a)/(p(a)+p(b))).
 //
 // Evaluated per bin, never as H(Σπp) − ΣπH(p) (which cancels catastrophically and can go
 // negative): JS = Σ_i [ π₁ p_i log₂(p_i/m_i) + π₂ q_i log₂(q_i/m_i) ],  m_i = π₁p_i + π₂q_i.
-// Accumulated in double, clamped to [0, 1]; zero bins contribute 0; never NaN.
+// Accumulated in double, clamped to [0, 1] (two-way) or [0, log₂ n] (n-ary); zero bins and bins
+// with p_i == q_i contribute exactly 0 (so identical inputs give exactly 0); never NaN.
+//
+// Speed: the two-way kernel is branch-free (info/log2.hpp) and, under GCC/Clang, written with
+// vector extensions: 2 doubles per SSE2 register, 4 per AVX register when the user compiles
+// with AVX. Bins are processed in blocks in two stages (ratios and divisions, then polynomials)
+// so that out-of-order cores overlap them. Measured on one Zen 3 core at 3.2 GHz, portable
+// -O2/-O3 (SSE2): about 180 million bins/s (std::log2 per bin: about 80 million); with -mavx2:
+// about 370 million. See benchmarks/bench_info.cpp. Other compilers get the same arithmetic one
+// bin at a time. Four accumulators, combined as (a0+a1)+(a2+a3), bin i going to a_(i mod 4):
+// the result is bit-identical for every vector width.
+// Accuracy: within a few 1e-16 (absolute) of a long-double reference, including subnormal
+// entries, p ≈ q to the last bit and a million bins (tests/core/test_info.cpp).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+#include "infolerp/core/status.hpp"
+#include "infolerp/info/log2.hpp"
 
 namespace infolerp {
 
 namespace detail {
-template <class T>
-double js_divergence_impl(std::span<const T> p, std::span<const T> q, double weight_p) noexcept {
-  const double wp = weight_p, wq = 1.0 - weight_p;
-  double sum = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double a = static_cast<double>(p[i]), b = static_cast<double>(q[i]);
-    const double m = wp * a + wq * b;
-    if (a > 0.0) sum += wp * a * std::log2(a / m);
-    if (b > 0.0) sum += wq * b * std::log2(b / m);
-  }
-  return std::clamp(sum, 0.0, 1.0);
+
+#if defined(__GNUC__) && !defined(INFOLERP_NO_VECTOR_EXTENSIONS)
+#define INFOLERP_JS_VECTOR 1
+#if defined(__AVX__)
+inline constexpr std::size_t js_lanes = 4;
+#else
+inline constexpr std::size_t js_lanes = 2;
+#endif
+typedef double js_vd __attribute__((vector_size(8 * js_lanes)));
+typedef std::uint64_t js_vu __attribute__((vector_size(8 * js_lanes)));
+#define INFOLERP_JS_UNROLL _Pragma("GCC unroll 2")
+#else
+#define INFOLERP_JS_VECTOR 0
+inline constexpr std::size_t js_lanes = 1;
+using js_vd = double;
+using js_vu = std::uint64_t;
+#define INFOLERP_JS_UNROLL
+#endif
+
+// All-ones where c holds (c is a vector comparison result, or a bool in the scalar build).
+#if INFOLERP_JS_VECTOR
+template <class C>
+inline js_vu js_mask(C c) noexcept { return std::bit_cast<js_vu>(c); }
+#else
+inline js_vu js_mask(bool c) noexcept { return std::uint64_t{0} - static_cast<std::uint64_t>(c); }
+#endif
+
+// Stage 1 of a bin (or a vector of bins): weights, ratio exponents, atanh arguments.
+struct js_stage {
+  js_vd pa, pb, k, sa, sb;
+};
+inline js_stage js_prepare(js_vd a, js_vd b, double wp, double wq) noexcept {
+  const js_vu keep = js_mask(a != b);  // equal bins contribute exactly 0
+  const js_vd pa = std::bit_cast<js_vd>(std::bit_cast<js_vu>(wp * a) & keep);
+  const js_vd pb = std::bit_cast<js_vd>(std::bit_cast<js_vu>(wq * b) & keep);
+  const js_vd inv_m = 1.0 / (pa + pb);  // Inf where pa + pb == 0: the weights below are 0 there
+  const log2_split<js_vd> ra = log2_reduce<js_vd, js_vu>(a * inv_m), rb = log2_reduce<js_vd, js_vu>(b * inv_m);
+  return {pa, pb, pa * ra.k + pb * rb.k, (ra.f - 1.0) / (ra.f + 1.0), (rb.f - 1.0) / (rb.f + 1.0)};
 }
+// Stage 2: π₁p log₂(p/m) + π₂q log₂(q/m).
+inline js_vd js_finish(const js_stage& s) noexcept {
+  return s.k + (s.pa * log_atanh_series(s.sa) + s.pb * log_atanh_series(s.sb)) * log2_e;
+}
+
+// Loads `count` (< lanes allowed: zero-padded) entries as doubles, times scale (pre, then inv).
+template <bool Scaled, class T>
+inline js_vd js_load(const T* x, std::size_t count, double pre, double inv) noexcept {
+#if INFOLERP_JS_VECTOR
+  js_vd v{};
+  if (std::is_same_v<T, double> && count >= js_lanes) std::memcpy(&v, x, sizeof v);
+  else for (std::size_t j = 0; j < js_lanes && j < count; ++j) v[j] = static_cast<double>(x[j]);
+#else
+  js_vd v = count ? static_cast<double>(*x) : 0.0;
+#endif
+  if constexpr (Scaled) v = (v * pre) * inv;
+  return v;
+}
+
+// The two-way kernel over p[0..n), q[0..n). Scaled: entries are first multiplied by pre_*
+// then inv_* (normalisation without overflow, see jensen_shannon).
+template <bool Scaled, class T>
+double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p = 1.0, double inv_p = 1.0,
+                 double pre_q = 1.0, double inv_q = 1.0) noexcept {
+  const double wq = 1.0 - wp;
+  constexpr std::size_t accumulators = 4 / js_lanes, block = 8;  // block: vectors per stage
+  js_vd acc[accumulators] = {};
+  std::size_t i = 0;
+  for (; i + block * js_lanes <= n; i += block * js_lanes) {
+    js_stage stage[block];
+    INFOLERP_JS_UNROLL
+    for (std::size_t v = 0; v < block; ++v) {
+      const std::size_t at = i + v * js_lanes;
+      stage[v] = js_prepare(js_load<Scaled>(p + at, js_lanes, pre_p, inv_p), js_load<Scaled>(q + at, js_lanes, pre_q, inv_q), wp, wq);
+    }
+    INFOLERP_JS_UNROLL
+    for (std::size_t v = 0; v < block; ++v) acc[v % accumulators] += js_finish(stage[v]);
+  }
+  for (std::size_t v = 0; i < n; i += js_lanes, ++v) {  // tail, zero-padded (zero bins add 0)
+    const std::size_t count = n - i;
+    acc[v % accumulators] += js_finish(js_prepare(js_load<Scaled>(p + i, count, pre_p, inv_p),
+                                                  js_load<Scaled>(q + i, count, pre_q, inv_q), wp, wq));
+  }
+  double lane[4];
+  static_assert(sizeof acc == sizeof lane);
+  std::memcpy(lane, acc, sizeof lane);
+  const double sum = (lane[0] + lane[1]) + (lane[2] + lane[3]);
+  return sum > 0.0 ? std::min(sum, 1.0) : 0.0;  // also maps NaN (broken preconditions) to 0
+}
+#undef INFOLERP_JS_UNROLL
+
+// Checks one user distribution and finds the factors that normalise it: x·pre·inv = x/Σx
+// without overflow or underflow of the sum. Errors name the distribution and the bin.
+struct distribution_scale {
+  double pre = 1.0, inv = 1.0;
+};
+// `what` names the entry point in messages ("jensen_shannon", "entropy", ...).
+template <class T>
+result<distribution_scale> check_distribution(std::span<const T> x, const char* what, const char* name, std::size_t index) {
+  const auto label = [&] { return index == no_element ? std::string(name) : std::string(name) + " " + std::to_string(index); };
+  if (x.empty()) return make_error(errc::empty_input, no_element, what, ": ", label(), " has no bins");
+  double sum = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double v = static_cast<double>(x[i]);
+    if (!std::isfinite(v)) return make_error(errc::non_finite, i, what, ": ", label(), " bin ", i, ": non-finite entry");
+    if (v < 0.0) return make_error(errc::bad_distribution, i, what, ": ", label(), " bin ", i, ": negative entry ", v);
+    sum += v;
+  }
+  if (!(sum > 0.0))
+    return make_error(errc::bad_distribution, no_element, what, ": ", label(), ": all ", x.size(),
+                      " bins are zero (no distribution to normalise)");
+  distribution_scale s;
+  if (!std::isfinite(sum) || sum < 0x1p-1000) {  // rescale by a power of two (exact) first
+    s.pre = std::isfinite(sum) ? 0x1p+64 : 0x1p-64;
+    sum = 0.0;
+    for (const T& v : x) sum += static_cast<double>(v) * s.pre;
+  }
+  s.inv = 1.0 / sum;
+  return s;
+}
+
 }  // namespace detail
 
 // Two-distribution JS with weights (weight_p, 1 − weight_p). Unchecked kernel for inner loops.
 // Preconditions: p.size() == q.size(); entries finite and >= 0; each sums to 1 (not
-// re-normalised); 0 <= weight_p <= 1. Result in [0, 1], 0 for identical inputs, 1 for disjoint
-// supports with equal weights. Complexity O(n), no allocation, thread-safe.
+// re-normalised); 0 <= weight_p <= 1. Result in [0, 1], exactly 0 for identical inputs, 1 for
+// disjoint supports with equal weights. Complexity O(n), no allocation, thread-safe.
 inline double js_divergence(std::span<const double> p, std::span<const double> q, double weight_p = 0.5) noexcept {
-  return detail::js_divergence_impl(p, q, weight_p);
+  return detail::js_kernel<false>(p.data(), q.data(), std::min(p.size(), q.size()), weight_p);
 }
 inline double js_divergence(std::span<const float> p, std::span<const float> q, double weight_p = 0.5) noexcept {
-  return detail::js_divergence_impl(p, q, weight_p);
+  return detail::js_kernel<false>(p.data(), q.data(), std::min(p.size(), q.size()), weight_p);
 }
 
 // JS(Y|a,b) of the clustering paper: rows p(Y|a), p(Y|b) weighted by the input probabilities
@@ -47,6 +176,89 @@ inline double js_channel(std::span<const double> row_a, std::span<const double> 
 inline double js_channel(std::span<const float> row_a, std::span<const float> row_b, double p_a, double p_b) noexcept {
   const double total = p_a + p_b;
   return js_divergence(row_a, row_b, total > 0.0 ? p_a / total : 0.5);
+}
+
+namespace detail {
+template <class T>
+result<double> jensen_shannon_checked(std::span<const T> p, std::span<const T> q, double weight_p) {
+  if (!(weight_p >= 0.0 && weight_p <= 1.0))
+    return make_error(errc::bad_parameter, no_element, "jensen_shannon: weight_p ", weight_p, " outside [0, 1]");
+  if (p.size() != q.size())
+    return make_error(errc::bad_distribution, no_element, "jensen_shannon: p has ", p.size(), " bins but q has ", q.size());
+  auto sp = check_distribution(p, "jensen_shannon", "p", no_element);
+  if (!sp) return sp.error();
+  auto sq = check_distribution(q, "jensen_shannon", "q", no_element);
+  if (!sq) return sq.error();
+  return js_kernel<true>(p.data(), q.data(), p.size(), weight_p, sp->pre, sp->inv, sq->pre, sq->inv);
+}
+}  // namespace detail
+
+// Checked two-way JS for user data: each distribution is normalised by its sum first, so
+// proportional inputs give ~0 (identical ones exactly 0).
+// Errors: weight_p outside [0, 1] or NaN (bad_parameter); different sizes (bad_distribution);
+// no bins (empty_input); a NaN/Inf entry (non_finite) or a negative entry (bad_distribution),
+// element() = the bin; all bins zero (bad_distribution). Complexity O(n), no allocation
+// (except the message on error), thread-safe.
+inline result<double> jensen_shannon(std::span<const double> p, std::span<const double> q, double weight_p = 0.5) {
+  return detail::jensen_shannon_checked(p, q, weight_p);
+}
+inline result<double> jensen_shannon(std::span<const float> p, std::span<const float> q, double weight_p = 0.5) {
+  return detail::jensen_shannon_checked(p, q, weight_p);
+}
+
+// n-ary weighted JS: Σ_i π_i Σ_y p_i(y) log₂(p_i(y)/m(y)), m = Σ_i π_i p_i, in [0, log₂ n].
+// Each distribution is normalised by its sum and the weights by theirs.
+// Errors: no distributions (empty_input); weights.size() != distributions.size() (bad_size);
+// a negative, NaN or Inf weight, or all weights 0 (bad_parameter, element() = the weight);
+// distributions of different sizes (bad_distribution, element() = the distribution); bad
+// entries as in the two-way form (element() = the bin; the message names distribution and bin).
+// Complexity O(n·bins), scalar (not the vectorised kernel), no allocation except on error.
+inline result<double> jensen_shannon(std::span<const std::span<const double>> distributions, std::span<const double> weights) {
+  const std::size_t k = distributions.size();
+  if (k == 0) return make_error(errc::empty_input, no_element, "jensen_shannon: no distributions");
+  if (weights.size() != k)
+    return make_error(errc::bad_size, no_element, "jensen_shannon: ", weights.size(), " weights for ", k, " distributions");
+  double weight_sum = 0.0;
+  for (std::size_t i = 0; i < k; ++i) {
+    if (!std::isfinite(weights[i]) || weights[i] < 0.0)
+      return make_error(errc::bad_parameter, i, "jensen_shannon: weight ", i, " is ", weights[i], " (must be finite and >= 0)");
+    weight_sum += weights[i];
+  }
+  if (!(weight_sum > 0.0) || !std::isfinite(weight_sum))
+    return make_error(errc::bad_parameter, no_element, "jensen_shannon: weights sum to ", weight_sum);
+  const std::size_t bins = distributions[0].size();
+  struct input {
+    detail::distribution_scale scale;
+    double weight = 0.0;
+  };
+  constexpr std::size_t small = 16;  // up to 16 distributions without allocating
+  input inputs_small[small];
+  std::vector<input> inputs_large(k > small ? k : 0);
+  input* inputs = k > small ? inputs_large.data() : inputs_small;
+  for (std::size_t i = 0; i < k; ++i) {
+    if (distributions[i].size() != bins)
+      return make_error(errc::bad_distribution, i, "jensen_shannon: distribution ", i, " has ", distributions[i].size(),
+                        " bins, distribution 0 has ", bins);
+    auto s = detail::check_distribution(distributions[i], "jensen_shannon", "distribution", i);
+    if (!s) return s.error();
+    inputs[i] = {*s, weights[i] / weight_sum};
+  }
+  const auto entry = [&](std::size_t i, std::size_t y) { return distributions[i][y] * inputs[i].scale.pre * inputs[i].scale.inv; };
+  double sum = 0.0;
+  for (std::size_t y = 0; y < bins; ++y) {
+    double m = 0.0, lo = entry(0, y), hi = lo;
+    for (std::size_t i = 0; i < k; ++i) {
+      m += inputs[i].weight * entry(i, y);
+      lo = std::min(lo, entry(i, y));
+      hi = std::max(hi, entry(i, y));
+    }
+    if (lo == hi) continue;  // all alike: contributes exactly 0 (identical inputs give 0)
+    for (std::size_t i = 0; i < k; ++i) {
+      const double x = entry(i, y);
+      if (x > 0.0 && inputs[i].weight > 0.0 && x != m) sum += inputs[i].weight * x * detail::log2_accurate(x / m);
+    }
+  }
+  return std::clamp(sum, 0.0, std::log2(static_cast<double>(k)));
 }
 
 }  // namespace infolerp

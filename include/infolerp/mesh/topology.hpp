@@ -81,14 +81,14 @@ result<mesh_topology> build_topology(const M& m) {
   {
     std::vector<std::uint32_t> cursor(start.begin(), start.end() - 1);
     for (std::size_t t = 0; t < nt; ++t)
-      for (std::uint32_t c = 0; c < 3; ++c) {
+      for (int c = 0; c < 3; ++c) {
         const std::uint32_t a = tris[t][c], b = tris[t][(c + 1) % 3];
-        if (a != b) buckets[cursor[std::min(a, b)]++] = {std::max(a, b), static_cast<std::uint32_t>(3 * t + c)};
+        if (a != b) buckets[cursor[std::min(a, b)]++] = {std::max(a, b), static_cast<std::uint32_t>(3 * t) + static_cast<std::uint32_t>(c)};
       }
   }
 
   topo.triangle_edges.assign(3 * nt, invalid_id);
-  topo.edge_faces.resize(buckets.size());
+  topo.edge_faces.reserve(buckets.size());
   topo.edges.reserve(buckets.size() / 2 + 1);
   topo.edge_face_offsets.reserve(buckets.size() / 2 + 2);
   for (std::size_t v = 0; v < nv; ++v) {
@@ -97,16 +97,18 @@ result<mesh_topology> build_topology(const M& m) {
     for (auto run = first; run != last;) {
       const auto e = static_cast<std::uint32_t>(topo.edges.size());
       topo.edges.push_back({static_cast<std::uint32_t>(v), run->hi});
-      topo.edge_face_offsets.push_back(static_cast<std::uint32_t>(run - buckets.begin()));
+      topo.edge_face_offsets.push_back(static_cast<std::uint32_t>(topo.edge_faces.size()));
       auto end = run;
       for (; end != last && end->hi == run->hi; ++end) {
         topo.triangle_edges[end->id] = e;
-        topo.edge_faces[static_cast<std::size_t>(end - buckets.begin())] = end->id / 3;
+        // A degenerate triangle (a, b, a) has edge (a, b) twice: list it once.
+        if (topo.edge_faces.size() == topo.edge_face_offsets.back() || topo.edge_faces.back() != end->id / 3)
+          topo.edge_faces.push_back(end->id / 3);
       }
       run = end;
     }
   }
-  topo.edge_face_offsets.push_back(static_cast<std::uint32_t>(buckets.size()));
+  topo.edge_face_offsets.push_back(static_cast<std::uint32_t>(topo.edge_faces.size()));
 
   // Dual graph: the other triangles on each of a triangle's edges.
   topo.neighbour_offsets.resize(nt + 1);

@@ -1,0 +1,117 @@
+// Mesh saliency and salient clustering (issue 4).
+// Goals: BM_Saliency_Exact on refined_elephant subdivided once 1:4 (~178k vertices) <= 1.0 s
+// wall on 2 cores; BM_Saliency_Approx <= 0.1 s at <= 1% relative L2 error against exact
+// (reported as the counter rel_l2_error, one run per approx_cells_per_sigma setting);
+// BM_SalientClustering on bunny00 with C = 10 <= 0.5 s.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <utility>
+#include "infolerp/core/executor.hpp"
+#include "infolerp/saliency/mesh_saliency.hpp"
+#include "support/mesh_io.hpp"
+
+namespace {
+
+// Midpoint 1:4 subdivision (each triangle into four; new vertices at edge midpoints).
+infolerp::indexed_mesh subdivide_midpoint(const infolerp::indexed_mesh& in) {
+  infolerp::indexed_mesh out;
+  out.positions = in.positions;
+  std::map<std::pair<unsigned, unsigned>, unsigned> mid;
+  auto midpoint = [&](unsigned a, unsigned b) {
+    const auto key = std::minmax(a, b);
+    auto [it, inserted] = mid.emplace(key, static_cast<unsigned>(out.positions.size()));
+    if (inserted) out.positions.push_back(0.5f * (in.positions[a] + in.positions[b]));
+    return it->second;
+  };
+  for (const auto& t : in.triangles) {
+    const unsigned a = midpoint(t.x, t.y), b = midpoint(t.y, t.z), c = midpoint(t.z, t.x);
+    out.triangles.insert(out.triangles.end(), {{t.x, a, c}, {t.y, b, a}, {t.z, c, b}, {a, b, c}});
+  }
+  return out;
+}
+
+const infolerp::indexed_mesh* elephant_subdivided() {
+  static std::optional<infolerp::indexed_mesh> mesh = [] {
+    auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("refined_elephant"));
+    return m.ok() ? std::optional(subdivide_midpoint(*m)) : std::nullopt;
+  }();
+  return mesh ? &*mesh : nullptr;
+}
+
+const std::vector<double>* elephant_exact_saliency() {
+  static std::optional<std::vector<double>> s = []() -> std::optional<std::vector<double>> {
+    const auto* m = elephant_subdivided();
+    if (!m) return std::nullopt;
+    auto r = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{2});
+    return r.ok() ? std::optional(std::move(r->saliency)) : std::nullopt;
+  }();
+  return s ? &*s : nullptr;
+}
+
+void BM_Saliency_Exact(benchmark::State& state) {
+  const auto* m = elephant_subdivided();
+  if (!m) return state.SkipWithError("refined_elephant not found");
+  for (auto _ : state) {
+    auto s = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{static_cast<int>(state.range(0))});
+    if (!s.ok()) return state.SkipWithError(s.error().message().c_str());
+    benchmark::DoNotOptimize(s->saliency.data());
+  }
+  state.counters["vertices"] = static_cast<double>(m->positions.size());
+}
+BENCHMARK(BM_Saliency_Exact)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+void BM_Saliency_Approx(benchmark::State& state) {
+  const auto* m = elephant_subdivided();
+  const auto* exact = elephant_exact_saliency();
+  if (!m || !exact) return state.SkipWithError("refined_elephant not found");
+  const infolerp::saliency_options opt{.method = infolerp::saliency_method::approximate,
+                                       .approx_cells_per_sigma = static_cast<double>(state.range(0)) / 4.0};
+  std::vector<double> last;
+  for (auto _ : state) {
+    auto s = infolerp::compute_saliency(*m, opt, infolerp::openmp_executor{2});
+    if (!s.ok()) return state.SkipWithError(s.error().message().c_str());
+    last = std::move(s->saliency);
+  }
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    num += (last[i] - (*exact)[i]) * (last[i] - (*exact)[i]);
+    den += (*exact)[i] * (*exact)[i];
+  }
+  state.counters["cells_per_sigma"] = opt.approx_cells_per_sigma;
+  state.counters["rel_l2_error"] = std::sqrt(num / den);
+}
+BENCHMARK(BM_Saliency_Approx)->DenseRange(4, 24, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+#include "infolerp/saliency/salient_clustering.hpp"
+
+namespace {
+void BM_SalientClustering(benchmark::State& state) {
+  static std::optional<std::pair<infolerp::indexed_mesh, std::vector<double>>> data = []()
+      -> std::optional<std::pair<infolerp::indexed_mesh, std::vector<double>>> {
+    auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("bunny00"));
+    if (!m.ok()) return std::nullopt;
+    auto s = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{2});
+    if (!s.ok()) return std::nullopt;
+    return std::pair{std::move(*m), std::move(s->saliency)};
+  }();
+  if (!data) return state.SkipWithError("bunny00 not found");
+  std::uint32_t iterations = 0;
+  bool converged = false;
+  for (auto _ : state) {
+    auto c = infolerp::salient_clustering(data->first, data->second, {.clusters = 10, .seed = 1});
+    if (!c.ok()) return state.SkipWithError(c.error().message().c_str());
+    iterations = c->iterations;
+    converged = c->converged;
+  }
+  state.counters["triangles"] = static_cast<double>(data->first.triangles.size());
+  state.counters["rounds"] = iterations;
+  state.counters["converged"] = converged ? 1.0 : 0.0;
+}
+BENCHMARK(BM_SalientClustering)->Unit(benchmark::kMillisecond)->UseRealTime();
+}  // namespace

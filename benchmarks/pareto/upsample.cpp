@@ -1,0 +1,406 @@
+// infolerp_pareto upsample --csv FILE [--size W H] [--threads N] [--ao N] [--soft N]
+//
+// Time against error of the I-Buffer upsampler (issue 6) and its competitors on the demo scene
+// (1025x1025 by default) with the reference shader (AO 64 rays, soft shadow 16 rays, hard-shadow
+// sun, textures; fixed ray sets, so the reference is exactly reproducible). Methods, in one run:
+//   full_single       full per-pixel evaluation, single rays (the reference, error 0)
+//   full_packets16    full per-pixel evaluation, AO and soft-shadow rays in 16-ray packets
+//   lowres_bilinear   a uniform coarse grid, fully shaded, bilinear colours; grid sized so that it
+//                     evaluates as many samples as the I-Buffer does (matched cost)
+//   joint_bilateral   primary ray + hard shadow at every pixel, AO and soft shadow on a coarse
+//                     grid, joint-bilateral (same object, normal, depth) interpolation of those
+//   contrast          the I-Buffer pass schedule deciding by a luminance-contrast test instead
+//                     of cluster ids
+//   ibuffer           the I-Buffer, 1-5 passes, several clusterings (STAND-IN clusterings, see
+//                     tests/support/demo_upsample.hpp, until include/infolerp/cluster lands)
+//   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
+//                     difference (§4.1's extension to other high-frequency signals)
+// Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim)
+// and FILE.png: PSNR against time (gnuplot), with FILE.gp/FILE.dat next to it.
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+#include <glm/geometric.hpp>
+#include <omp.h>
+#include "infolerp/upsample/upsampler.hpp"
+#include "pareto.hpp"
+#include "support/demo_scene.hpp"
+#include "support/demo_upsample.hpp"
+#include "support/embree_tracer.hpp"
+#include "support/image.hpp"
+#include "support/reference_shader.hpp"
+#include "support/ssim.hpp"
+
+namespace {
+
+namespace sup = infolerp::support;
+using sample = sup::demo_sample;
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::vector<float> luma_of(const sup::image& img) {
+  std::vector<float> l(img.pixels.size());
+  for (std::size_t i = 0; i < l.size(); ++i) l[i] = sup::display_luma(img.pixels[i]);
+  return l;
+}
+
+struct row {
+  std::string method, setting;
+  double seconds = 0, evaluated_fraction = 0, psnr = 0, ssim = 0;
+};
+
+// The contrast competitor: the same pass schedule and record, but two samples may be
+// interpolated when their shaded display luma differ by at most `threshold`.
+struct contrast_sample {
+  sample s;
+  float luma = 0.0f;
+  bool background() const { return s.background(); }
+};
+struct contrast_source {
+  using sample_type = contrast_sample;
+  sup::demo_ibuffer_source base;
+  float threshold = 0.05f;
+  contrast_sample evaluate(std::uint32_t x, std::uint32_t y) const {
+    contrast_sample c{base.evaluate(x, y), 0.0f};
+    c.luma = sup::display_luma(base.shade(c.s, x, y));
+    return c;
+  }
+  bool compatible(const contrast_sample& a, const contrast_sample& b) const {
+    return std::abs(a.luma - b.luma) <= threshold;
+  }
+  contrast_sample interpolate(const contrast_sample& a, const contrast_sample& b) const {
+    return {infolerp::interpolate(a.s, b.s), 0.5f * (a.luma + b.luma)};
+  }
+  contrast_sample interpolate(const contrast_sample& a, const contrast_sample& b, const contrast_sample& c,
+                              const contrast_sample& d) const {
+    return {infolerp::interpolate(a.s, b.s, c.s, d.s), 0.25f * ((a.luma + b.luma) + (c.luma + d.luma))};
+  }
+  glm::vec3 shade(const contrast_sample& c, std::uint32_t x, std::uint32_t y) const { return base.shade(c.s, x, y); }
+};
+
+// The I-Buffer with the occlusion terms in the compatibility test as well (the §4.1 extension
+// to "other high frequency signals"): same cluster, same light bits, and AO and soft-shadow
+// ratios within `tolerance`.
+struct occlusion_checked_source : sup::demo_ibuffer_source {
+  float tolerance = 0.1f;
+  bool compatible(const sample& a, const sample& b) const {
+    return infolerp::compatible(a, b) && std::abs(a.occlusion[0] - b.occlusion[0]) <= tolerance &&
+           std::abs(a.occlusion[1] - b.occlusion[1]) <= tolerance;
+  }
+};
+
+class harness {
+ public:
+  harness(const sup::demo_scene& scene, const sup::shader_options& shading, int width, int height, int threads)
+      : scene_(scene), shading_(shading), single_(scene, shading), w_(width), h_(height), threads_(threads) {}
+
+  int run(const std::string& csv_path) {
+    // (1) the reference: full per-pixel evaluation with single rays.
+    {
+      const double t0 = now_seconds();
+      auto st = sup::render_reference(single_, w_, h_, reference_, threads_);
+      if (!st) return fail(st.error().message());
+      t_full_ = now_seconds() - t0;
+      ref_luma_ = luma_of(reference_);
+      add("full_single", "1 ray per call", t_full_, 1.0, reference_);
+    }
+    // (2) 16-ray packets.
+    {
+      sup::shader_options o = shading_;
+      o.packets = true;
+      const sup::reference_shader packets(scene_, o);
+      sup::image img;
+      const double t0 = now_seconds();
+      auto st = sup::render_reference(packets, w_, h_, img, threads_);
+      if (!st) return fail(st.error().message());
+      add("full_packets16", "AO+soft shadow rays in 16-ray packets", now_seconds() - t0, 1.0, img);
+    }
+    // (6) the I-Buffer with several clusterings and 1-5 passes.
+    std::vector<sup::scene_clustering> clusterings;
+    clusterings.push_back(sup::cluster_by_object(scene_));
+    for (int cells : {1, 2, 4}) clusterings.push_back(sup::cluster_by_normal(scene_, cells));
+    std::vector<double> matched_fraction(6, 1.0);  // evaluated fraction of the finest stand-in, per passes
+    for (const auto& c : clusterings) {
+      for (std::uint32_t passes = 1; passes <= 5; ++passes) {
+        const sup::demo_ibuffer_source src{&single_, &c, w_, h_};
+        double f = 0;
+        if (!run_upsampler<sample>(src, passes, "ibuffer",
+                                   c.name + " (" + std::to_string(c.count()) + " clusters), " + std::to_string(passes) + " passes", f))
+          return 1;
+        if (c.name == "normal2") matched_fraction[passes] = f;
+      }
+    }
+    // (6b) the I-Buffer with the occlusion terms also tested.
+    for (float tolerance : {0.05f, 0.1f}) {
+      for (std::uint32_t passes = 3; passes <= 5; ++passes) {
+        occlusion_checked_source src;
+        static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusterings[2], w_, h_};
+        src.tolerance = tolerance;
+        double f = 0;
+        char setting[96];
+        std::snprintf(setting, sizeof setting, "normal2 + |dAO|,|dsoft| <= %.2f, %u passes", static_cast<double>(tolerance), passes);
+        if (!run_upsampler<sample>(src, passes, "ibuffer_occl", setting, f)) return 1;
+      }
+    }
+    // (5) the same schedule deciding by luminance contrast.
+    for (float threshold : {0.02f, 0.05f}) {
+      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+        const contrast_source src{{&single_, &clusterings[0], w_, h_}, threshold};
+        double f = 0;
+        char setting[96];
+        std::snprintf(setting, sizeof setting, "luma contrast <= %.2f, %u passes", static_cast<double>(threshold), passes);
+        if (!run_upsampler<contrast_sample>(src, passes, "contrast", setting, f)) return 1;
+      }
+    }
+    // (3) uniform low resolution + bilinear at the I-Buffer's evaluated fraction.
+    for (std::uint32_t passes = 2; passes <= 5; ++passes) lowres_bilinear(matched_fraction[passes], passes);
+    // (4) joint-bilateral upsampling of the expensive terms from a 2^(p-1) grid.
+    for (std::uint32_t passes = 2; passes <= 5; ++passes) joint_bilateral(1 << (passes - 1));
+    return write(csv_path);
+  }
+
+ private:
+  static int fail(const std::string& message) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", message.c_str());
+    return 1;
+  }
+
+  void add(const std::string& method, const std::string& setting, double seconds, double evaluated_fraction,
+           const sup::image& img) {
+    row r{method, setting, seconds, evaluated_fraction, 0, 0};
+    r.psnr = *sup::psnr(reference_, img);
+    r.ssim = *sup::ssim(ref_luma_, luma_of(img), w_, h_);
+    std::printf("%-16s %-48s %8.3f s  x%6.2f  eval %.4f  PSNR %6.2f dB  SSIM %.5f\n", method.c_str(), setting.c_str(),
+                seconds, t_full_ / seconds, evaluated_fraction, r.psnr, r.ssim);
+    std::fflush(stdout);
+    rows_.push_back(r);
+  }
+
+  template <class Sample, class Source>
+  bool run_upsampler(const Source& src, std::uint32_t passes, const std::string& method, const std::string& setting,
+                     double& evaluated_fraction) {
+    auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
+                                                  {.passes = passes, .max_passes = passes, .rows_per_task = 2});
+    if (!up) return fail(up.error().message()) == 0;
+    sup::image img(w_, h_);
+    const double t0 = now_seconds();
+    auto s = up->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads_});
+    const double t = now_seconds() - t0;
+    if (!s) return fail(s.message()) == 0;
+    evaluated_fraction = up->stats().evaluated_fraction();
+    add(method, setting, t, evaluated_fraction, img);
+    return true;
+  }
+
+  void lowres_bilinear(double fraction, std::uint32_t passes) {
+    // A gw x gh grid spanning the image corners with about fraction * W * H samples.
+    const double spacing = 1.0 / std::sqrt(std::max(fraction, 1e-6));
+    const int gw = std::max(2, static_cast<int>(std::lround((w_ - 1) / spacing)) + 1);
+    const int gh = std::max(2, static_cast<int>(std::lround((h_ - 1) / spacing)) + 1);
+    const float sx = static_cast<float>(w_ - 1) / static_cast<float>(gw - 1);
+    const float sy = static_cast<float>(h_ - 1) / static_cast<float>(gh - 1);
+    std::vector<glm::vec3> grid(static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh));
+    sup::image img(w_, h_);
+    const double t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_ > 0 ? threads_ : omp_get_max_threads())
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) {
+        std::uint64_t rays = 0;
+        const auto in = single_.evaluate_pixel(static_cast<float>(i) * sx + 0.5f, static_cast<float>(j) * sy + 0.5f, w_, h_, rays);
+        grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(i)] = single_.shade(in);
+      }
+#pragma omp parallel for schedule(static) num_threads(threads_ > 0 ? threads_ : omp_get_max_threads())
+    for (int y = 0; y < h_; ++y) {
+      const float gy = static_cast<float>(y) / sy;
+      const int j = std::min(static_cast<int>(gy), gh - 2);
+      const float fy = gy - static_cast<float>(j);
+      for (int x = 0; x < w_; ++x) {
+        const float gx = static_cast<float>(x) / sx;
+        const int i = std::min(static_cast<int>(gx), gw - 2);
+        const float fx = gx - static_cast<float>(i);
+        auto g = [&](int a, int b) { return grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(a)]; };
+        img.at(x, y) = (1 - fy) * ((1 - fx) * g(i, j) + fx * g(i + 1, j)) + fy * ((1 - fx) * g(i, j + 1) + fx * g(i + 1, j + 1));
+      }
+    }
+    const double t = now_seconds() - t0;
+    char setting[96];
+    std::snprintf(setting, sizeof setting, "%dx%d grid (matches ibuffer normal2, %u passes)", gw, gh, passes);
+    add("lowres_bilinear", setting, t, static_cast<double>(grid.size()) / (static_cast<double>(w_) * h_), img);
+  }
+
+  void joint_bilateral(int step) {
+    // Primary-only shader: primary ray + the hard-shadow ray; AO and soft shadow come from the grid.
+    sup::shader_options po = shading_;
+    po.ao_rays = 0;
+    po.soft_shadow_rays = 0;
+    const sup::reference_shader primary(scene_, po);
+    const int gw = (w_ - 1 + step - 1) / step + 1, gh = (h_ - 1 + step - 1) / step + 1;
+    std::vector<sup::shading_inputs> grid(static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh));
+    sup::image img(w_, h_);
+    const int nthreads = threads_ > 0 ? threads_ : omp_get_max_threads();
+    long long fallbacks = 0;
+    const glm::vec3 eye = scene_.view.eye;
+    const double t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) {
+        std::uint64_t rays = 0;
+        grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(i)] =
+            single_.evaluate_pixel(static_cast<float>(i * step) + 0.5f, static_cast<float>(j * step) + 0.5f, w_, h_, rays);
+      }
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads) reduction(+ : fallbacks)
+    for (int y = 0; y < h_; ++y) {
+      const int j = y / step;
+      const float fy = static_cast<float>(y - j * step) / static_cast<float>(step);
+      for (int x = 0; x < w_; ++x) {
+        std::uint64_t rays = 0;
+        sup::shading_inputs in =
+            primary.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays);
+        if (in.hit()) {
+          const int i = x / step;
+          const float fx = static_cast<float>(x - i * step) / static_cast<float>(step);
+          const float depth = glm::length(in.position - eye);
+          float wsum = 0, ao = 0, soft = 0;
+          for (int b = 0; b < 2; ++b)
+            for (int a = 0; a < 2; ++a) {
+              const int gi = std::min(i + a, gw - 1), gj = std::min(j + b, gh - 1);
+              const auto& c = grid[static_cast<std::size_t>(gj) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(gi)];
+              if (c.geometry != in.geometry) continue;
+              const float wb = (a ? fx : 1 - fx) * (b ? fy : 1 - fy) + 1e-6f;
+              const float wn = std::exp(-(1.0f - glm::dot(c.normal, in.normal)) / 0.05f);
+              const float wd = std::exp(-std::abs(glm::length(c.position - eye) - depth) / (0.02f * depth));
+              const float wt = wb * wn * wd;
+              wsum += wt;
+              ao += wt * c.ao;
+              soft += wt * c.soft_shadow;
+            }
+          if (wsum > 1e-4f) {
+            in.ao = ao / wsum;
+            in.soft_shadow = soft / wsum;
+          } else {  // no similar coarse sample: evaluate this pixel fully
+            in = single_.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays);
+            ++fallbacks;
+          }
+        }
+        img.at(x, y) = single_.shade(in);
+      }
+    }
+    const double t = now_seconds() - t0;
+    char setting[96];
+    std::snprintf(setting, sizeof setting, "AO+soft on a 1/%d grid, primary+sun per pixel", step);
+    add("joint_bilateral", setting, t,
+        (static_cast<double>(grid.size()) + static_cast<double>(fallbacks)) / (static_cast<double>(w_) * h_), img);
+  }
+
+  int write(const std::string& csv_path) {
+    std::ofstream csv(csv_path);
+    if (!csv) return fail("cannot write " + csv_path);
+    csv << "method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim\n";
+    char line[512];
+    for (const auto& r : rows_) {
+      std::snprintf(line, sizeof line, "%s,\"%s\",%.6f,%.4f,%.6f,%.4f,%.6f\n", r.method.c_str(), r.setting.c_str(),
+                    r.seconds, t_full_ / r.seconds, r.evaluated_fraction, r.psnr, r.ssim);
+      csv << line;
+    }
+    csv.close();
+    std::printf("wrote %s\n", csv_path.c_str());
+    // Plot: PSNR (capped at 60 dB for the exact methods) against seconds, one series per method.
+    const std::string base = csv_path.size() > 4 && csv_path.ends_with(".csv") ? csv_path.substr(0, csv_path.size() - 4) : csv_path;
+    std::ofstream dat(base + ".dat");
+    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer", "ibuffer_occl"};
+    for (const char* m : methods) {
+      dat << "# " << m << "\n";
+      for (const auto& r : rows_)
+        if (r.method == m) dat << r.seconds << " " << std::min(r.psnr, 60.0) << " " << r.ssim << "\n";
+      dat << "\n\n";
+    }
+    dat.close();
+    std::ofstream gp(base + ".gp");
+    gp << "set terminal pngcairo size 1000,650 noenhanced\nset output '" << base << ".png'\n"
+       << "set title 'Demo scene " << w_ << "x" << h_ << ": PSNR against render time (exact methods drawn at 60 dB)'\n"
+       << "set xlabel 'seconds (log)'\nset ylabel 'PSNR dB vs full per-pixel evaluation'\nset logscale x\nset grid\n"
+       << "set key bottom right\nplot ";
+    for (int i = 0; i < 7; ++i)
+      gp << (i ? ", " : "") << "'" << base << ".dat' index " << i << " using 1:2 with points pt " << (i + 4)
+         << " title '" << methods[i] << "'";
+    gp << "\n";
+    gp.close();
+    const std::string cmd = "gnuplot '" + base + ".gp'";
+    if (std::system(cmd.c_str()) == 0) std::printf("wrote %s.png\n", base.c_str());
+    else std::fprintf(stderr, "infolerp_pareto upsample: gnuplot failed; the data is in %s.dat\n", base.c_str());
+    return 0;
+  }
+
+  const sup::demo_scene& scene_;
+  sup::shader_options shading_;
+  sup::reference_shader single_;
+  int w_, h_, threads_;
+  sup::image reference_;
+  std::vector<float> ref_luma_;
+  double t_full_ = 0;
+  std::vector<row> rows_;
+};
+
+bool parse_int(const char* text, int lo, int hi, int& out) {
+  const std::string_view s(text);
+  int v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || end != s.data() + s.size() || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+}  // namespace
+
+int pareto_upsample(int argc, char** argv) {
+  std::string csv;
+  int width = 1025, height = 1025, threads = 0, ao = 64, soft = 16;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const bool has1 = i + 1 < argc, has2 = i + 2 < argc;
+    if (a == "--csv" && has1) {
+      csv = argv[++i];
+    } else if (a == "--size" && has2 && parse_int(argv[i + 1], 16, 16384, width) && parse_int(argv[i + 2], 16, 16384, height)) {
+      i += 2;
+    } else if (a == "--threads" && has1 && parse_int(argv[i + 1], 1, 1024, threads)) {
+      ++i;
+    } else if (a == "--ao" && has1 && parse_int(argv[i + 1], 0, 4096, ao)) {
+      ++i;
+    } else if (a == "--soft" && has1 && parse_int(argv[i + 1], 0, 4096, soft)) {
+      ++i;
+    } else {
+      std::fprintf(stderr, "usage: infolerp_pareto upsample --csv FILE [--size W H] [--threads N] [--ao N] [--soft N]\n");
+      return 2;
+    }
+  }
+  if (csv.empty()) {
+    std::fprintf(stderr, "infolerp_pareto upsample: --csv FILE is required\n");
+    return 2;
+  }
+  // Flush-to-zero on every OpenMP worker (the reference renderer sets it on its own workers).
+  sup::enable_flush_to_zero();
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
+  sup::enable_flush_to_zero();
+  const sup::embree_device device;
+  auto scene = sup::make_demo_scene(device);
+  if (!scene) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", scene.error().message().c_str());
+    return 1;
+  }
+  const sup::shader_options shading{.ao_rays = static_cast<unsigned>(ao), .soft_shadow_rays = static_cast<unsigned>(soft)};
+  std::printf("demo scene %dx%d, AO %d rays, soft shadow %d rays, threads %d\n", width, height, ao, soft,
+              threads > 0 ? threads : omp_get_max_threads());
+  harness h(*scene, shading, width, height, threads);
+  return h.run(csv);
+}

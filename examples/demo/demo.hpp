@@ -1,0 +1,103 @@
+#pragma once
+// What the demo's stages share. main.cpp parses the options, builds the scene and renders the
+// per-pixel reference; later stages (clusters, saliency, upsampler) are functions taking a
+// demo_context, declared in examples/demo/stage_<name>.hpp and called from main.cpp in order.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <glm/geometric.hpp>
+#include "support/demo_scene.hpp"
+#include "support/embree_tracer.hpp"
+#include "support/image.hpp"
+#include "support/reference_shader.hpp"
+
+namespace infolerp::demo {
+
+struct demo_options {
+  int width = 1025;                  // --size W H
+  int height = 1025;
+  int threads = 0;                   // --threads N (0 = all cores)
+  std::filesystem::path out_dir = "infolerp-out";  // --out DIR
+  std::string mesh_path;             // --mesh FILE (empty: built-in scene only)
+  support::shader_options shader;    // --ao N, --soft N
+};
+
+struct demo_context {
+  demo_options options;
+  const support::demo_scene& scene;
+  const support::reference_shader& shader;
+  support::image reference;               // the full per-pixel render (filled by the first stage)
+  support::render_stats reference_stats;  // its time and ray count
+};
+
+// A one-line progress bar on stderr: call with (done, total); prints only when the
+// bar grows and ends the line at 100%. Not thread-safe (callers serialise).
+class progress_bar {
+ public:
+  explicit progress_bar(std::string label) : label_(std::move(label)) {}
+  void operator()(int done, int total) {
+    const int percent = total > 0 ? 100 * done / total : 100;
+    const int filled = percent / 2;
+    if (filled == last_) return;  // at most 51 updates
+    last_ = filled;
+    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled, "##################################################",
+                 50 - filled, "", percent);
+    if (percent == 100) std::fputc('\n', stderr);
+    std::fflush(stderr);
+  }
+
+ private:
+  std::string label_;
+  int last_ = -1;
+};
+
+// One line on stderr for a failed status (without the library's "infolerp: " prefix).
+inline void report(const status& s) {
+  std::string_view m = s.message();
+  if (m.starts_with("infolerp: ")) m.remove_prefix(10);
+  std::fprintf(stderr, "infolerp_demo: %.*s\n", static_cast<int>(m.size()), m.data());
+}
+
+// Writes img as DIR/name, reporting failure on stderr. Returns success.
+inline bool save_png(const demo_context& ctx, const support::image& img, const std::string& name) {
+  const std::string path = (ctx.options.out_dir / name).string();
+  if (auto s = support::write_png(img, path); !s) {
+    report(s);
+    return false;
+  }
+  std::printf("wrote %s\n", path.c_str());
+  return true;
+}
+
+// An image of the scene coloured per surface point: colour(geometry, triangle, barycentric) for
+// each primary hit, dimmed by a headlight term so shapes stay readable; sky pixels are black.
+// Used by the clusters and saliency stages. Parallel over rows (OpenMP).
+inline support::image render_false_colour(
+    const demo_context& ctx, const std::function<glm::vec3(std::uint32_t, std::uint32_t, glm::vec2)>& colour) {
+  const int w = ctx.options.width, h = ctx.options.height;
+  support::image img(w, h);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int y = 0; y < h; ++y) {
+    support::enable_flush_to_zero();
+    for (int x = 0; x < w; ++x) {
+      const ray r = ctx.scene.view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w, h);
+      const hit hh = ctx.scene.tracer.intersect(r);
+      glm::vec3 c(0.0f);
+      if (hh.valid()) {
+        const auto& m = ctx.scene.objects[hh.geometry].mesh;
+        const glm::uvec3 t = m.triangles[hh.triangle];
+        const glm::vec3 n = glm::normalize(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+        const float light = 0.35f + 0.65f * std::abs(glm::dot(n, r.direction));
+        c = light * colour(hh.geometry, hh.triangle, hh.barycentric);
+      }
+      img.at(x, y) = c;
+    }
+  }
+  return img;
+}
+
+}  // namespace infolerp::demo

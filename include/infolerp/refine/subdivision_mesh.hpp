@@ -1,0 +1,539 @@
+#pragma once
+// Hierarchical subdivision mesh: Oliveira, Santos, Proença, "Refinement Criteria for High
+// Fidelity Interactive Walkthroughs", §4.2 (1:4 subdivision at edge midpoints, after Loop 1987,
+// propagated to neighbours, 1:2 splits where the neighbour is flat), and the large-triangle
+// tessellation of "Feature-based clustered geometry for interpolated ray-casting", §4.1.
+//
+// Every original triangle owns a hierarchy; triangles are never deleted, so an id stays valid
+// for the life of the mesh. The leaves form the current, always conforming, triangulation.
+//
+// THE RULE (red–green refinement; the paper leaves the closure open, this is what we do):
+//  1. A selected leaf splits 1:4 ("red") at its three edge midpoints. A midpoint is created
+//     once per edge and shared by both sides, so a vertex is shaded once.
+//  2. A leaf that gets a midpoint on one of its edges (a "hanging" vertex) must split:
+//       - one hanging edge, the leaf is within `propagation_depth` steps of the selected
+//         triangle and its height-to-width ratio over that edge (height of the opposite corner
+//         over the edge length) is >= `bisect_ratio`: it splits 1:4 and propagates further;
+//       - one hanging edge otherwise: it splits 1:2 ("green", bisecting that edge) and stops;
+//       - two or three hanging edges: it splits 1:4 (a 1:2 split cannot close them).
+//  3. A 1:2 child is never split itself (that degrades shape). When one is selected, or gets a
+//     hanging vertex, its two-child split is undone ("retired": the two children stay in the
+//     hierarchy's storage with `retired` set, no longer children of anyone) and the parent
+//     splits 1:4 instead, reusing the existing midpoint; the closure continues from there.
+//  4. Closure runs to completion inside every split call: between calls no T-vertex exists, and
+//     every leaf edge is matched by exactly one leaf edge on the other side (or lies on a
+//     boundary edge of the input mesh).
+// Shape: red children are similar to their parent and green children are never split, so the
+// smallest angle is at least half the input's smallest angle.
+//
+// Children order: a red split of (v0,v1,v2) with midpoints m0=(v0v1), m1=(v1v2), m2=(v2v0)
+// gives (v0,m0,m2), (m0,v1,m1), (m2,m1,v2), (m0,m1,m2); a green split on edge k with
+// (a,b,c) = (v_k, v_k+1, v_k+2) and midpoint m of ab gives (a,m,c), (m,b,c). Winding is kept.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+#include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/mesh/adaptors.hpp"
+
+namespace infolerp {
+
+struct subdivision_options {
+  float bisect_ratio = 0.5f;            // propagated neighbours flatter than this (height/width) split 1:2
+  std::uint32_t propagation_depth = 1;  // 1:4 splits propagate this many neighbour steps (paper: unbounded)
+};
+
+// One triangle of the hierarchy (32 bytes).
+struct subdivision_triangle {
+  glm::uvec3 vertices{0u};                  // winding of the original triangle
+  std::uint32_t parent = invalid_id;        // invalid_id for an original triangle
+  std::uint32_t first_child = invalid_id;   // children are first_child .. first_child + child_count - 1
+  std::uint32_t original = invalid_id;      // the input triangle this one lies in
+  std::uint8_t level = 0;                   // 0 for original triangles
+  std::uint8_t child_count = 0;             // 0 (leaf or retired), 2 (1:2 split) or 4 (1:4 split)
+  std::uint8_t split_edge = 0;              // for a 1:2 split: the bisected edge k (corner k to k+1)
+  std::uint8_t retired = 0;                 // 1 or 2: first or second 1:2 child, replaced by the parent's 1:4 split
+                                            // (split_edge then keeps the parent's bisected edge)
+  [[nodiscard]] bool is_leaf() const noexcept { return child_count == 0 && retired == 0; }
+};
+
+// Where a point lies: the leaf and the point's barycentric weights for the leaf's vertices.
+struct point_location {
+  std::uint32_t leaf = invalid_id;
+  glm::vec3 weights{0.0f};
+};
+
+namespace detail {
+// Open-addressing map from an undirected edge (a, b) to its midpoint vertex and the (at most
+// two) current leaves that have exactly this edge. Entries are never erased.
+class edge_table {
+ public:
+  struct entry {
+    std::uint64_t key;
+    std::uint32_t midpoint;
+    std::uint32_t face[2];
+  };
+  static constexpr std::uint64_t empty_key = ~std::uint64_t{0};
+
+  void reserve(std::size_t n) {
+    std::size_t cap = 16;
+    while (cap < 2 * n) cap *= 2;
+    if (cap > slots_.size()) rehash(cap);
+  }
+  [[nodiscard]] std::size_t size() const noexcept { return count_; }
+
+  [[nodiscard]] const entry* find(std::uint32_t a, std::uint32_t b) const noexcept {
+    if (slots_.empty()) return nullptr;
+    const std::uint64_t k = key(a, b);
+    for (std::size_t i = slot(k);; i = (i + 1) & mask_) {
+      if (slots_[i].key == k) return &slots_[i];
+      if (slots_[i].key == empty_key) return nullptr;
+    }
+  }
+  [[nodiscard]] std::uint32_t midpoint(std::uint32_t a, std::uint32_t b) const noexcept {
+    const entry* e = find(a, b);
+    return e ? e->midpoint : invalid_id;
+  }
+  // The entry of (a, b), inserted (no midpoint, no faces) when absent. The reference is valid
+  // until the next call of get().
+  entry& get(std::uint32_t a, std::uint32_t b) {
+    if (2 * (count_ + 1) > slots_.size()) rehash(std::max<std::size_t>(16, 2 * slots_.size()));
+    const std::uint64_t k = key(a, b);
+    std::size_t i = slot(k);
+    for (; slots_[i].key != k; i = (i + 1) & mask_) {
+      if (slots_[i].key == empty_key) {
+        slots_[i] = {k, invalid_id, {invalid_id, invalid_id}};
+        ++count_;
+        break;
+      }
+    }
+    return slots_[i];
+  }
+  // Adds a leaf to the edge; false when the edge already has two (a non-manifold edge).
+  static bool add_face(entry& e, std::uint32_t t) noexcept {
+    if (e.face[0] == invalid_id) e.face[0] = t;
+    else if (e.face[1] == invalid_id) e.face[1] = t;
+    else return false;
+    return true;
+  }
+  static void remove_face(entry& e, std::uint32_t t) noexcept {
+    if (e.face[0] == t) {
+      e.face[0] = e.face[1];
+      e.face[1] = invalid_id;
+    } else if (e.face[1] == t) {
+      e.face[1] = invalid_id;
+    }
+  }
+  static std::uint32_t other_face(const entry& e, std::uint32_t t) noexcept {
+    return e.face[0] == t ? e.face[1] : e.face[0];
+  }
+
+ private:
+  static std::uint64_t key(std::uint32_t a, std::uint32_t b) noexcept {
+    return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
+  }
+  [[nodiscard]] std::size_t slot(std::uint64_t k) const noexcept {
+    return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> shift_);
+  }
+  void rehash(std::size_t cap) {
+    std::vector<entry> old(cap, entry{empty_key, invalid_id, {invalid_id, invalid_id}});
+    old.swap(slots_);
+    mask_ = cap - 1;
+    shift_ = 64;
+    for (std::size_t c = cap; c > 1; c >>= 1) --shift_;
+    for (const entry& e : old) {
+      if (e.key == empty_key) continue;
+      std::size_t i = slot(e.key);
+      while (slots_[i].key != empty_key) i = (i + 1) & mask_;
+      slots_[i] = e;
+    }
+  }
+  std::vector<entry> slots_;
+  std::size_t count_ = 0;
+  std::size_t mask_ = 0;
+  unsigned shift_ = 64;
+};
+}  // namespace detail
+
+// §4.1 of the clustering paper: "tessellate these polygons until they had a ratio of polygon
+// area to on-screen-projected area below a user-provided threshold". A triangle's own
+// area/projected-area ratio does not change under 1:4 splitting, so we read the ratio as the
+// triangle's projected area over the screen's area: split while it exceeds `max_fraction`.
+// Triangles with a corner at or behind the eye plane (w <= 0) always count as too large
+// (tessellate's max_level bounds them).
+struct screen_fraction_test {
+  glm::mat4 view_projection{1.0f};  // world to clip space
+  float max_fraction = 0.01f;       // largest share of the screen a triangle may cover
+  bool operator()(glm::vec3 a, glm::vec3 b, glm::vec3 c) const {
+    const glm::vec4 ca = view_projection * glm::vec4(a, 1.0f), cb = view_projection * glm::vec4(b, 1.0f),
+                    cc = view_projection * glm::vec4(c, 1.0f);
+    if (!(ca.w > 0.0f && cb.w > 0.0f && cc.w > 0.0f)) return true;
+    const glm::vec2 pa = glm::vec2(ca) / ca.w, pb = glm::vec2(cb) / cb.w, pc = glm::vec2(cc) / cc.w;
+    const glm::vec2 e1 = pb - pa, e2 = pc - pa;
+    const float ndc_area = 0.5f * std::abs(e1.x * e2.y - e1.y * e2.x);
+    return ndc_area / 4.0f > max_fraction;  // the screen spans [-1,1]², area 4
+  }
+};
+
+class subdivision_mesh {
+ public:
+  // Builds the hierarchy roots (triangle t of the input is hierarchy triangle t, vertex v is
+  // vertex v). Errors: no triangles; non-finite position; index out of range; degenerate
+  // triangle (repeated index or zero area); an edge shared by more than two triangles;
+  // bisect_ratio negative or NaN. Complexity O(V + T) expected; allocation O(V + T).
+  template <class M>
+  static result<subdivision_mesh> build(const M& m, subdivision_options options = {}) {
+    static_assert(check_mesh<M>());
+    if (!(options.bisect_ratio >= 0.0f))
+      return make_error(errc::bad_parameter, no_element, "bisect_ratio ", options.bisect_ratio, " must be >= 0");
+    const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
+    if (nt == 0) return make_error(errc::empty_input, no_element, "mesh has no triangles");
+    if (nv >= invalid_id / 2 || nt >= invalid_id / 8)
+      return make_error(errc::unsupported, no_element, "mesh too large for 32-bit subdivision ids");
+    subdivision_mesh s;
+    s.options_ = options;
+    s.positions_.resize(nv);
+    s.vertex_source_.assign(nv, invalid_id);
+    for (std::size_t v = 0; v < nv; ++v) {
+      const glm::vec3 p = mesh_position(m, v);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return make_error(errc::non_finite, v, "vertex ", v, ": non-finite position");
+      s.positions_[v] = p;
+    }
+    s.tris_.resize(nt);
+    s.edges_.reserve(3 * nt / 2 + 3);
+    for (std::size_t t = 0; t < nt; ++t) {
+      const glm::uvec3 tri = mesh_triangle(m, t);
+      for (int c = 0; c < 3; ++c)
+        if (tri[c] >= nv)
+          return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
+                            " out of range (vertex count ", nv, ")");
+      if (tri.x == tri.y || tri.y == tri.z || tri.z == tri.x)
+        return make_error(errc::degenerate_triangle, t, "triangle ", t, ": repeated vertex index");
+      const glm::dvec3 p0(s.positions_[tri.x]), p1(s.positions_[tri.y]), p2(s.positions_[tri.z]);
+      if (!(glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0))
+        return make_error(errc::degenerate_triangle, t, "triangle ", t, ": zero area");
+      const auto id = static_cast<std::uint32_t>(t);
+      s.tris_[t].vertices = tri;
+      s.tris_[t].original = id;
+      for (int c = 0; c < 3; ++c) {
+        if (s.vertex_source_[tri[c]] == invalid_id) s.vertex_source_[tri[c]] = id;
+        auto& e = s.edges_.get(tri[c], tri[(c + 1) % 3]);
+        if (!detail::edge_table::add_face(e, id))
+          return make_error(errc::non_manifold_edge, t, "triangle ", t, ": edge (", tri[c], ", ", tri[(c + 1) % 3],
+                            ") is shared by more than two triangles");
+      }
+    }
+    s.original_count_ = nt;
+    s.leaf_count_ = nt;
+    return s;
+  }
+
+  [[nodiscard]] const subdivision_options& options() const noexcept { return options_; }
+  [[nodiscard]] std::size_t vertex_count() const noexcept { return positions_.size(); }
+  [[nodiscard]] glm::vec3 position(std::size_t v) const { return positions_[v]; }
+  [[nodiscard]] std::span<const glm::vec3> positions() const noexcept { return positions_; }
+  // An original triangle the vertex lies in (the one it was created in); invalid_id for an
+  // input vertex no triangle uses.
+  [[nodiscard]] std::uint32_t vertex_source(std::size_t v) const { return vertex_source_[v]; }
+  // Every triangle ever produced, retired ones included.
+  [[nodiscard]] std::size_t triangle_count() const noexcept { return tris_.size(); }
+  [[nodiscard]] std::size_t original_triangle_count() const noexcept { return original_count_; }
+  [[nodiscard]] std::size_t leaf_count() const noexcept { return leaf_count_; }
+  [[nodiscard]] const subdivision_triangle& triangle(std::size_t t) const { return tris_[t]; }
+  [[nodiscard]] std::span<const subdivision_triangle> triangles() const noexcept { return tris_; }
+  [[nodiscard]] bool is_leaf(std::size_t t) const { return tris_[t].is_leaf(); }
+  // The midpoint vertex of edge (a, b), or invalid_id.
+  [[nodiscard]] std::uint32_t edge_midpoint(std::uint32_t a, std::uint32_t b) const noexcept {
+    return edges_.midpoint(a, b);
+  }
+
+  // Selects triangle t for subdivision and closes the mesh (THE RULE above). A triangle that
+  // is no longer a leaf (already split, or retired) is left alone: not an error.
+  // Errors: t >= triangle_count(). Complexity: O(new triangles) expected (the closure is
+  // local); allocation: amortised growth of the triangle, vertex and edge arrays.
+  status split(std::uint32_t t) { return split(t, options_.propagation_depth); }
+  // As above with an explicit propagation depth (0: only the closure, no 1:4 propagation).
+  status split(std::uint32_t t, std::uint32_t propagation_depth) {
+    if (t >= tris_.size())
+      return make_error(errc::index_out_of_range, t, "triangle ", t, " out of range (", tris_.size(), " triangles)");
+    select(t, propagation_depth);
+    return {};
+  }
+  // Splits each selected triangle in order (see split). Errors: the first id out of range
+  // (the ones before it are split).
+  status split(std::span<const std::uint32_t> selected) {
+    for (std::uint32_t t : selected)
+      if (auto st = split(t); !st) return st;
+    return {};
+  }
+
+  // The leaf containing the point with Embree barycentrics (u, v) in original triangle
+  // `original` (point = (1-u-v)·p0 + u·p1 + v·p2), and its weights for the leaf's vertices.
+  // Points outside the triangle are clamped to the nearest child at each level.
+  // Preconditions: original < original_triangle_count(). O(level of the leaf), no allocation.
+  [[nodiscard]] point_location locate(std::uint32_t original, glm::vec2 uv) const {
+    return locate_from(original, glm::vec3(1.0f - uv.x - uv.y, uv.x, uv.y));
+  }
+  // Continues a location from any triangle of the hierarchy (a previous leaf, even a retired
+  // one) given the point's barycentric weights for that triangle's vertices. This is how a
+  // pixel follows its leaf as it is split. Descends in double: weights lose no precision
+  // relative to the input as the levels get deeper.
+  [[nodiscard]] point_location locate_from(std::uint32_t t, glm::vec3 weights) const {
+    double w[3] = {weights.x, weights.y, weights.z};
+    for (;;) {
+      const subdivision_triangle& n = tris_[t];
+      if (n.retired) {  // lift the weights to the parent (see the children order)
+        const bool second = n.retired == 2;
+        const double wa = second ? 0.5 * w[0] : w[0] + 0.5 * w[1];
+        const double wb = second ? 0.5 * w[0] + w[1] : 0.5 * w[1];
+        const double wc = w[2];
+        const int k = n.split_edge;
+        w[k] = wa;
+        w[(k + 1) % 3] = wb;
+        w[(k + 2) % 3] = wc;
+        t = n.parent;
+        continue;
+      }
+      if (n.child_count == 0) break;
+      if (n.child_count == 4) {
+        int c = 3;
+        for (int i = 0; i < 3; ++i)
+          if (w[i] >= 0.5) c = i;
+        double cw[3];
+        if (c == 3) {
+          cw[0] = 1.0 - 2.0 * w[2];
+          cw[1] = 1.0 - 2.0 * w[0];
+          cw[2] = 1.0 - 2.0 * w[1];
+        } else {  // corner child c keeps corner c in slot c
+          for (int i = 0; i < 3; ++i) cw[i] = 2.0 * w[i];
+          cw[c] -= 1.0;
+        }
+        std::copy(cw, cw + 3, w);
+        t = n.first_child + static_cast<std::uint32_t>(c);
+      } else {
+        const int k = n.split_edge;
+        const double wa = w[k], wb = w[(k + 1) % 3], wc = w[(k + 2) % 3];
+        if (wa >= wb) {
+          w[0] = wa - wb, w[1] = 2.0 * wb, w[2] = wc;
+          t = n.first_child;
+        } else {
+          w[0] = 2.0 * wa, w[1] = wb - wa, w[2] = wc;
+          t = n.first_child + 1;
+        }
+      }
+    }
+    return {t, glm::vec3(static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2]))};
+  }
+
+  // Appends the ids of the current leaves, ascending. O(triangle_count()).
+  void leaves(std::vector<std::uint32_t>& out) const {
+    for (std::size_t t = 0; t < tris_.size(); ++t)
+      if (tris_[t].is_leaf()) out.push_back(static_cast<std::uint32_t>(t));
+  }
+  // The current leaves as a mesh over all vertices (leaf i is the i-th leaf in id order).
+  [[nodiscard]] indexed_mesh leaf_mesh() const {
+    indexed_mesh out;
+    out.positions = positions_;
+    out.triangles.reserve(leaf_count_);
+    for (const subdivision_triangle& n : tris_)
+      if (n.is_leaf()) out.triangles.push_back(n.vertices);
+    return out;
+  }
+
+  // Clustering paper §4.1: splits (closure only, no propagation) every leaf for which
+  // needs_split(p0, p1, p2) holds, repeatedly, until none does or the leaf reached max_level.
+  // Use screen_fraction_test for the paper's criterion. Returns the number of selections.
+  // Complexity O(final triangles · rounds) with rounds <= max_level.
+  template <class NeedsSplit>
+  std::size_t tessellate(NeedsSplit&& needs_split, std::uint32_t max_level = 8) {
+    std::size_t selections = 0;
+    std::vector<std::uint32_t> work;
+    for (;;) {
+      work.clear();
+      for (std::size_t t = 0; t < tris_.size(); ++t) {
+        const subdivision_triangle& n = tris_[t];
+        if (!n.is_leaf() || n.level >= max_level) continue;
+        if (needs_split(positions_[n.vertices.x], positions_[n.vertices.y], positions_[n.vertices.z]))
+          work.push_back(static_cast<std::uint32_t>(t));
+      }
+      if (work.empty()) break;
+      for (std::uint32_t t : work) {
+        // A neighbour's closure may have split t 1:2 meanwhile; t wanted 1:4 (rule 3).
+        if (tris_[t].child_count == 2) select(tris_[t].first_child, 0);
+        else select(t, 0);
+      }
+      selections += work.size();
+    }
+    return selections;
+  }
+
+ private:
+  static constexpr std::uint32_t closure_only = std::numeric_limits<std::uint32_t>::max() / 2;
+  struct pending {
+    std::uint32_t triangle, depth;
+  };
+
+  void select(std::uint32_t t, std::uint32_t propagation_depth) {
+    const subdivision_triangle& n = tris_[t];
+    if (!n.is_leaf()) return;
+    limit_ = propagation_depth;
+    if (n.parent != invalid_id && tris_[n.parent].child_count == 2) resplit_green(n.parent, 0);
+    else split_red(t, 0);
+    close();
+  }
+
+  void close() {
+    while (head_ < queue_.size()) {
+      const pending p = queue_[head_++];
+      const subdivision_triangle& n = tris_[p.triangle];
+      if (!n.is_leaf()) continue;
+      int hanging = 0, edge = 0;
+      for (int k = 0; k < 3; ++k)
+        if (edges_.midpoint(n.vertices[k], n.vertices[(k + 1) % 3]) != invalid_id) ++hanging, edge = k;
+      if (hanging == 0) continue;
+      if (n.parent != invalid_id && tris_[n.parent].child_count == 2) {
+        resplit_green(n.parent, closure_only);
+      } else if (hanging == 1 && !(p.depth <= limit_ &&
+                                   height_width_ratio(p.triangle, edge) >= options_.bisect_ratio)) {
+        split_green(p.triangle, edge);
+      } else {
+        split_red(p.triangle, p.depth);
+      }
+    }
+    queue_.clear();
+    head_ = 0;
+  }
+
+  [[nodiscard]] double height_width_ratio(std::uint32_t t, int k) const {
+    const glm::uvec3 v = tris_[t].vertices;
+    const glm::dvec3 a(positions_[v[k]]), b(positions_[v[(k + 1) % 3]]), c(positions_[v[(k + 2) % 3]]);
+    const glm::dvec3 ab = b - a;
+    return glm::length(glm::cross(ab, c - a)) / glm::dot(ab, ab);  // (2·area / width) / width
+  }
+
+  // The midpoint of edge (a, b) of leaf t, created when absent; the leaf on the other side of
+  // a new midpoint now has a hanging vertex and is queued at depth + 1.
+  std::uint32_t make_midpoint(std::uint32_t a, std::uint32_t b, std::uint32_t t, std::uint32_t depth) {
+    auto& e = edges_.get(a, b);
+    detail::edge_table::remove_face(e, t);
+    if (e.midpoint != invalid_id) return e.midpoint;
+    const auto m = static_cast<std::uint32_t>(positions_.size());
+    e.midpoint = m;
+    if (e.face[0] != invalid_id) queue_.push_back({e.face[0], depth + 1});
+    positions_.push_back(0.5f * (positions_[a] + positions_[b]));
+    vertex_source_.push_back(tris_[t].original);
+    return m;
+  }
+  // Attaches child c to edge (a, b); queues it when (a, b) already has a midpoint.
+  void attach(std::uint32_t a, std::uint32_t b, std::uint32_t c, bool may_hang) {
+    auto& e = edges_.get(a, b);
+    const bool ok = detail::edge_table::add_face(e, c);
+    INFOLERP_ASSERT(ok);
+    (void)ok;
+    if (may_hang && e.midpoint != invalid_id) queue_.push_back({c, closure_only});
+  }
+  // A new interior edge shared by two new children.
+  void attach_inner(std::uint32_t a, std::uint32_t b, std::uint32_t c0, std::uint32_t c1) {
+    auto& e = edges_.get(a, b);
+    e.face[0] = c0;
+    e.face[1] = c1;
+  }
+  void detach(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    detail::edge_table::remove_face(edges_.get(a, b), c);
+  }
+  std::uint32_t add_child(std::uint32_t parent, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    const auto id = static_cast<std::uint32_t>(tris_.size());
+    subdivision_triangle n;
+    n.vertices = {a, b, c};
+    n.parent = parent;
+    n.original = tris_[parent].original;
+    INFOLERP_ASSERT(tris_[parent].level < 255);
+    n.level = static_cast<std::uint8_t>(tris_[parent].level + 1);
+    tris_.push_back(n);
+    return id;
+  }
+
+  void split_red(std::uint32_t t, std::uint32_t depth) {
+    const glm::uvec3 v = tris_[t].vertices;
+    const std::uint32_t m0 = make_midpoint(v[0], v[1], t, depth);
+    const std::uint32_t m1 = make_midpoint(v[1], v[2], t, depth);
+    const std::uint32_t m2 = make_midpoint(v[2], v[0], t, depth);
+    const std::uint32_t c0 = add_child(t, v[0], m0, m2);
+    const std::uint32_t c1 = add_child(t, m0, v[1], m1);
+    const std::uint32_t c2 = add_child(t, m2, m1, v[2]);
+    const std::uint32_t c3 = add_child(t, m0, m1, m2);
+    tris_[t].first_child = c0;
+    tris_[t].child_count = 4;
+    leaf_count_ += 3;
+    attach(v[0], m0, c0, true);
+    attach(m0, v[1], c1, true);
+    attach(v[1], m1, c1, true);
+    attach(m1, v[2], c2, true);
+    attach(v[2], m2, c2, true);
+    attach(m2, v[0], c0, true);
+    attach_inner(m0, m2, c0, c3);
+    attach_inner(m0, m1, c1, c3);
+    attach_inner(m1, m2, c2, c3);
+  }
+
+  void split_green(std::uint32_t t, int k) {
+    const glm::uvec3 v = tris_[t].vertices;
+    const std::uint32_t a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
+    const std::uint32_t m = make_midpoint(a, b, t, closure_only);
+    detach(b, c, t);
+    detach(c, a, t);
+    const std::uint32_t c0 = add_child(t, a, m, c);
+    const std::uint32_t c1 = add_child(t, m, b, c);
+    tris_[t].first_child = c0;
+    tris_[t].child_count = 2;
+    tris_[t].split_edge = static_cast<std::uint8_t>(k);
+    leaf_count_ += 1;
+    attach(a, m, c0, true);
+    attach(m, b, c1, true);
+    attach(b, c, c1, false);
+    attach(c, a, c0, false);
+    attach_inner(m, c, c0, c1);
+  }
+
+  // Rule 3: undo the 1:2 split of p and split it 1:4.
+  void resplit_green(std::uint32_t p, std::uint32_t depth) {
+    subdivision_triangle& n = tris_[p];
+    for (std::uint32_t i = 0; i < 2; ++i) {
+      subdivision_triangle& c = tris_[n.first_child + i];
+      for (int k = 0; k < 3; ++k) detach(c.vertices[k], c.vertices[(k + 1) % 3], n.first_child + i);
+      c.retired = static_cast<std::uint8_t>(i + 1);
+      c.split_edge = n.split_edge;
+    }
+    for (int k = 0; k < 3; ++k) {
+      auto& e = edges_.get(n.vertices[k], n.vertices[(k + 1) % 3]);
+      detail::edge_table::add_face(e, p);
+    }
+    n.child_count = 0;
+    n.first_child = invalid_id;
+    leaf_count_ -= 1;
+    split_red(p, depth);
+  }
+
+  subdivision_options options_;
+  std::vector<glm::vec3> positions_;
+  std::vector<std::uint32_t> vertex_source_;
+  std::vector<subdivision_triangle> tris_;
+  detail::edge_table edges_;
+  std::vector<pending> queue_;
+  std::size_t head_ = 0;
+  std::uint32_t limit_ = 0;  // propagation depth of the current selection
+  std::size_t original_count_ = 0;
+  std::size_t leaf_count_ = 0;
+};
+
+}  // namespace infolerp

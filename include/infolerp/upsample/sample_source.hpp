@@ -1,0 +1,191 @@
+#pragma once
+// What the I-Buffer upsampler asks of the engine: a sample source.
+//
+// Paper: "Feature-based clustered geometry for interpolated Ray-casting", §4 and §4.1. Each
+// I-Buffer sample stores "its position, texture coordinates, cluster ID, normal" plus the ratio
+// of occluded samples for soft shadows and ambient occlusion (§4), and hard-shadow light bits
+// "compacted in a single integer value" (§4.1). Texture coordinates are interpolated, never the
+// textured colours (§5, Fig. 12), so a sample becomes a colour only after interpolation.
+//
+// A sample source S models:
+//   typename S::sample_type                               the I-Buffer record (copyable)
+//   sample_type evaluate(uint32_t x, uint32_t y) const    full evaluation (primary ray + the
+//                                                         expensive terms) at pixel (x, y)
+//   Pixel shade(const sample_type&, uint32_t x, uint32_t y) const     the sample's colour
+// and, as members of S or as free functions found by ADL for sample_type (the default record
+// below has them):
+//   bool compatible(const sample_type& a, const sample_type& b)        may a and b be interpolated?
+//   sample_type interpolate(const sample_type& a, const sample_type& b)             weights 1/2
+//   sample_type interpolate(const sample_type& a, b, c, d)                          weights 1/4
+// `compatible` must be false between background and geometry, and between samples whose
+// hard-shadow light bits differ; it is meant to be an equivalence relation (same cluster id).
+// evaluate/shade/compatible/interpolate are called concurrently from the executor's threads,
+// so they must be thread-safe for concurrent const calls, and deterministic (the same inputs
+// give the same bits), or the upsampler cannot promise identical output across thread counts.
+// Pixel coordinates may lie outside the image, up to 2^(passes-1) - 1 beyond its right and
+// bottom edge (the cropped border of §4); a pinhole camera extrapolates naturally.
+#include <array>
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include "infolerp/core/status.hpp"
+
+namespace infolerp {
+
+// Placeholder for light bits that a scene without hard-shadow lights compiles out.
+struct no_light_bits {
+  friend constexpr bool operator==(no_light_bits, no_light_bits) noexcept = default;
+};
+
+// The default I-Buffer record (§4). OcclusionTerms: ratios such as ambient occlusion and
+// soft-shadow visibility per area light. HardShadowLights = false removes the light bits and
+// their test at compile time (§4.1 for scenes without hard-shadow lights).
+// Background (a primary ray that hits nothing) has cluster == invalid_id and is never
+// compatible with geometry.
+template <std::size_t OcclusionTerms = 2, bool HardShadowLights = true>
+struct surface_sample {
+  using light_bits_type = std::conditional_t<HardShadowLights, std::uint32_t, no_light_bits>;
+  static constexpr bool has_light_bits = HardShadowLights;
+  static constexpr std::size_t occlusion_terms = OcclusionTerms;
+
+  glm::vec3 position{0.0f};                  // world-space hit point
+  glm::vec3 normal{0.0f};                    // shading normal (interpolated unnormalised: normalise in shade)
+  glm::vec2 texcoord{0.0f};                  // texture coordinates, interpolated (never colours)
+  std::uint32_t cluster = invalid_id;        // cluster id of the hit triangle; invalid_id = background
+  [[no_unique_address]] light_bits_type lights{};  // bit i: light i (of up to 32) is visible
+  std::array<float, OcclusionTerms> occlusion{};   // unoccluded ratios (AO, soft shadows) in [0, 1]
+
+  [[nodiscard]] constexpr bool background() const noexcept { return cluster == invalid_id; }
+};
+
+// Same cluster (background counts as its own cluster) and, when compiled in, same light bits.
+// Complexity O(1). Equivalence relation.
+template <std::size_t K, bool L>
+[[nodiscard]] constexpr bool compatible(const surface_sample<K, L>& a, const surface_sample<K, L>& b) noexcept {
+  if constexpr (L) {
+    return a.cluster == b.cluster && a.lights == b.lights;
+  } else {
+    return a.cluster == b.cluster;
+  }
+}
+
+// Midpoint of an edge: continuous attributes averaged with weights 1/2, cluster and light bits
+// taken from a (equal to b's whenever compatible(a, b)). O(1), no allocation.
+template <std::size_t K, bool L>
+[[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& a,
+                                                         const surface_sample<K, L>& b) noexcept {
+  surface_sample<K, L> s = a;
+  s.position = 0.5f * (a.position + b.position);
+  s.normal = 0.5f * (a.normal + b.normal);
+  s.texcoord = 0.5f * (a.texcoord + b.texcoord);
+  for (std::size_t i = 0; i < K; ++i) s.occlusion[i] = 0.5f * (a.occlusion[i] + b.occlusion[i]);
+  return s;
+}
+
+// Centre of a cell from its four corners, weights 1/4 each, summed as (a + b) + (c + d).
+template <std::size_t K, bool L>
+[[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& a, const surface_sample<K, L>& b,
+                                                         const surface_sample<K, L>& c,
+                                                         const surface_sample<K, L>& d) noexcept {
+  surface_sample<K, L> s = a;
+  s.position = 0.25f * ((a.position + b.position) + (c.position + d.position));
+  s.normal = 0.25f * ((a.normal + b.normal) + (c.normal + d.normal));
+  s.texcoord = 0.25f * ((a.texcoord + b.texcoord) + (c.texcoord + d.texcoord));
+  for (std::size_t i = 0; i < K; ++i)
+    s.occlusion[i] = 0.25f * ((a.occlusion[i] + b.occlusion[i]) + (c.occlusion[i] + d.occlusion[i]));
+  return s;
+}
+
+namespace detail {
+template <class S>
+using sample_of = typename S::sample_type;
+
+template <class S>
+concept member_compatible = requires(const S& s, const sample_of<S>& a) {
+  { s.compatible(a, a) } -> std::convertible_to<bool>;
+};
+template <class S>
+concept member_interpolate = requires(const S& s, const sample_of<S>& a) {
+  { s.interpolate(a, a) } -> std::convertible_to<sample_of<S>>;
+  { s.interpolate(a, a, a, a) } -> std::convertible_to<sample_of<S>>;
+};
+template <class T>
+concept adl_compatible = requires(const T& a) {
+  { compatible(a, a) } -> std::convertible_to<bool>;
+};
+template <class T>
+concept adl_interpolate = requires(const T& a) {
+  { interpolate(a, a) } -> std::convertible_to<T>;
+  { interpolate(a, a, a, a) } -> std::convertible_to<T>;
+};
+}  // namespace detail
+
+template <class S>
+concept sample_source = requires { typename S::sample_type; } &&
+    std::copyable<typename S::sample_type> &&
+    requires(const S& s, std::uint32_t x, const typename S::sample_type& a) {
+      { s.evaluate(x, x) } -> std::convertible_to<typename S::sample_type>;
+      s.shade(a, x, x);
+    } &&
+    (detail::member_compatible<S> || detail::adl_compatible<typename S::sample_type>) &&
+    (detail::member_interpolate<S> || detail::adl_interpolate<typename S::sample_type>);
+
+// One readable message per missing piece instead of template noise.
+template <class S>
+constexpr bool check_sample_source() {
+  static_assert(requires { typename S::sample_type; },
+                "infolerp: sample source needs a member type `sample_type` (the I-Buffer record)");
+  if constexpr (requires { typename S::sample_type; }) {
+    static_assert(requires(const S& s, std::uint32_t x) {
+                    { s.evaluate(x, x) } -> std::convertible_to<typename S::sample_type>;
+                  },
+                  "infolerp: sample source needs `sample_type evaluate(uint32_t x, uint32_t y) const`");
+    static_assert(requires(const S& s, std::uint32_t x, const typename S::sample_type& a) { s.shade(a, x, x); },
+                  "infolerp: sample source needs `Pixel shade(const sample_type&, uint32_t x, uint32_t y) const`");
+    static_assert(detail::member_compatible<S> || detail::adl_compatible<typename S::sample_type>,
+                  "infolerp: sample source needs `bool compatible(const sample_type&, const sample_type&)` "
+                  "(member, or a free function found by ADL)");
+    static_assert(detail::member_interpolate<S> || detail::adl_interpolate<typename S::sample_type>,
+                  "infolerp: sample source needs `interpolate(a, b)` and `interpolate(a, b, c, d)` returning "
+                  "sample_type (members, or free functions found by ADL)");
+  }
+  return sample_source<S>;
+}
+
+// The pixel type a source shades into.
+template <class S>
+using pixel_type_of = std::remove_cvref_t<decltype(std::declval<const S&>().shade(
+    std::declval<const typename S::sample_type&>(), std::uint32_t{}, std::uint32_t{}))>;
+
+namespace detail {
+template <class S>
+[[nodiscard]] inline bool source_compatible(const S& s, const sample_of<S>& a, const sample_of<S>& b) {
+  if constexpr (member_compatible<S>) {
+    return s.compatible(a, b);
+  } else {
+    return compatible(a, b);
+  }
+}
+template <class S>
+[[nodiscard]] inline sample_of<S> source_interpolate(const S& s, const sample_of<S>& a, const sample_of<S>& b) {
+  if constexpr (member_interpolate<S>) {
+    return s.interpolate(a, b);
+  } else {
+    return interpolate(a, b);
+  }
+}
+template <class S>
+[[nodiscard]] inline sample_of<S> source_interpolate(const S& s, const sample_of<S>& a, const sample_of<S>& b,
+                                                     const sample_of<S>& c, const sample_of<S>& d) {
+  if constexpr (member_interpolate<S>) {
+    return s.interpolate(a, b, c, d);
+  } else {
+    return interpolate(a, b, c, d);
+  }
+}
+}  // namespace detail
+
+}  // namespace infolerp

@@ -1,0 +1,362 @@
+#pragma once
+// The I-Buffer upsampler: multi-pass rendering that evaluates samples only where the picture
+// changes and interpolates everywhere else.
+//
+// Paper: "Feature-based clustered geometry for interpolated Ray-casting", §4 (Fig. 7). The
+// first pass evaluates a coarse N×M grid; each pass goes to (2N−1)×(2M−1): samples that
+// coincide with the previous pass are re-used (R), a new sample between 2 (edge) or 4 (centre)
+// previous samples is interpolated (I) when those samples are compatible (same cluster id, same
+// hard-shadow light bits, §4.1), otherwise evaluated (E). One buffer per pass (the I-Buffer
+// pyramid, "about one-third of the final image size" on top of the final buffer).
+//
+// Any output size: the paper starts from an N×M grid whose last pass covers the image and crops
+// the border. We compute exactly the same samples but skip the cropped ones: the last pass has
+// the image size W×H and a pass of size w needs w' = floor(w/2) + 1 samples of the pass before
+// it. Every kept sample sits where the paper's uncropped pyramid puts it (pixel (i·2^d, j·2^d)
+// for a sample (i, j) d passes before the last), so the result is the crop of the paper's.
+// At most 2^(passes−1) − 1 pixels beyond the right and bottom edge are evaluated.
+//
+// Determinism: each output row of a pass depends only on the previous pass, so rows run in
+// parallel through the user's executor and the output is identical for any executor and thread
+// count. Time is measured with `Clock` (std::chrono::steady_clock by default, or the user's) for
+// the statistics only; it never changes a pixel. Only a pass controller that the user feeds
+// with these times (pass_controller.hpp) can change the output, through the pass count.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <type_traits>
+#include <utility>
+#include <vector>
+#include "infolerp/core/executor.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/upsample/sample_source.hpp"
+
+namespace infolerp {
+
+// Largest pass count the pyramid supports (samples 2^15 pixels apart in the first pass).
+inline constexpr std::uint32_t max_upsample_passes = 16;
+
+// How a sample of a pass was obtained (Fig. 7).
+enum class sample_kind : std::uint8_t {
+  evaluated = 0,     // E: full evaluation by the sample source
+  interpolated = 1,  // I: interpolated from 2 or 4 compatible samples of the previous pass
+  reused = 2,        // R: copied from the coincident sample of the previous pass
+};
+
+struct upsampler_options {
+  std::uint32_t passes = 4;         // passes per frame; 1 = plain per-pixel evaluation
+  std::uint32_t max_passes = 4;     // pyramid depth allocated up front; passes may change up to it without allocating
+  std::uint32_t rows_per_task = 4;  // rows of a pass per executor task (the parallel_for grain)
+  bool record_kinds = true;         // keep the R/I/E kind of every pixel of the last pass (kinds())
+  bool keep_ibuffer = false;        // keep the last pass's samples (ibuffer()); off: shade straight into the frame
+};
+
+// Statistics of one pass.
+struct pass_stats {
+  std::uint32_t width = 0;        // size of this pass's buffer (after cropping)
+  std::uint32_t height = 0;
+  std::size_t reused = 0;         // R samples
+  std::size_t interpolated = 0;   // I samples
+  std::size_t evaluated = 0;      // E samples
+  double seconds = 0.0;           // wall time of the pass (Clock), statistics only
+};
+
+// Statistics of one frame: pass[0] is the coarse pass, pass[passes − 1] the full-size one.
+struct upsample_stats {
+  std::uint32_t passes = 0;
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::array<pass_stats, max_upsample_passes> pass{};
+  double seconds = 0.0;  // wall time of the whole frame, including shading
+
+  // Evaluated samples over all passes (the expensive work).
+  [[nodiscard]] std::size_t evaluated() const noexcept {
+    std::size_t n = 0;
+    for (std::uint32_t p = 0; p < passes; ++p) n += pass[p].evaluated;
+    return n;
+  }
+  // Interpolated samples over all passes.
+  [[nodiscard]] std::size_t interpolated() const noexcept {
+    std::size_t n = 0;
+    for (std::uint32_t p = 0; p < passes; ++p) n += pass[p].interpolated;
+    return n;
+  }
+  // Evaluated samples per output pixel: 1 for plain evaluation, slightly above 1 at worst
+  // (the cropped border), far below 1 when clusters are large.
+  [[nodiscard]] double evaluated_fraction() const noexcept {
+    const double pixels = static_cast<double>(width) * static_cast<double>(height);
+    return pixels > 0.0 ? static_cast<double>(evaluated()) / pixels : 0.0;
+  }
+};
+
+namespace detail {
+// Samples of the previous pass needed by a pass of n samples along one axis.
+constexpr std::uint32_t coarser_extent(std::uint32_t n) noexcept { return n / 2 + 1; }  // n >= 1
+
+template <class T>
+concept has_background_flag = requires(const T& s) {
+  { s.background() } -> std::convertible_to<bool>;
+};
+
+// compatible() plus the library's own guarantee that background never mixes with geometry.
+template <class S>
+[[nodiscard]] inline bool may_interpolate(const S& src, const sample_of<S>& a, const sample_of<S>& b) {
+  if constexpr (has_background_flag<sample_of<S>>) {
+    if (static_cast<bool>(a.background()) != static_cast<bool>(b.background())) return false;
+  }
+  return source_compatible(src, a, b);
+}
+}  // namespace detail
+
+// The stateful upsampler (geometry-central style: construct once, render every frame).
+// Holds one buffer per pass for the largest pass count; rendering allocates nothing.
+// Not thread-safe: one render at a time per object (the render itself runs in parallel).
+template <class Sample, class Clock = std::chrono::steady_clock>
+class upsampler {
+ public:
+  using sample_type = Sample;
+
+  // An upsampler for a width×height image, or why not: width or height 0 (errc::empty_input),
+  // max_passes outside [1, 16], passes outside [1, max_passes], rows_per_task 0, or a side
+  // above 2^24 (errc::bad_parameter).
+  // Allocation: the coarser passes, about (1/3)·W·H samples (precisely Σ_{d≥1} w_d·h_d ≤
+  // 1/3·W·H + 4(W+H) + 4·max_passes samples with w_0 = W, w_d = floor(w_{d−1}/2)+1), plus W·H
+  // more with keep_ibuffer, W·H bytes with record_kinds, and H row counters.
+  [[nodiscard]] static result<upsampler> create(std::uint32_t width, std::uint32_t height,
+                                                upsampler_options options = {}) {
+    upsampler u;
+    u.options_ = options;
+    if (options.max_passes == 0 || options.max_passes > max_upsample_passes)
+      return make_error(errc::bad_parameter, no_element, "upsampler: max_passes ", options.max_passes,
+                        " outside [1, ", max_upsample_passes, "]");
+    if (options.rows_per_task == 0)
+      return make_error(errc::bad_parameter, no_element, "upsampler: rows_per_task must be at least 1");
+    if (status s = u.set_passes(options.passes); !s) return s;
+    if (status s = u.resize(width, height); !s) return s;
+    return u;
+  }
+
+  // Changes the image size; reallocates the pyramid. Errors as in create(); on error the
+  // upsampler keeps its previous size.
+  [[nodiscard]] status resize(std::uint32_t width, std::uint32_t height) {
+    if (width == 0 || height == 0)
+      return make_error(errc::empty_input, no_element, "upsampler: image size ", width, "x", height, " is empty");
+    constexpr std::uint32_t limit = 1u << 24;
+    if (width > limit || height > limit)
+      return make_error(errc::bad_parameter, no_element, "upsampler: image size ", width, "x", height,
+                        " above 2^24 per side");
+    width_ = width;
+    height_ = height;
+    std::uint32_t w = width, h = height;
+    for (std::uint32_t d = 0; d < options_.max_passes; ++d) {
+      extents_[d] = {w, h};
+      const bool stored = d > 0 || options_.keep_ibuffer;
+      levels_[d].assign(stored ? static_cast<std::size_t>(w) * h : 0, Sample{});
+      w = detail::coarser_extent(w);
+      h = detail::coarser_extent(h);
+    }
+    for (std::uint32_t d = options_.max_passes; d < max_upsample_passes; ++d) {
+      extents_[d] = {0, 0};
+      levels_[d] = {};
+    }
+    kinds_.assign(options_.record_kinds ? static_cast<std::size_t>(width) * height : 0, sample_kind::evaluated);
+    row_counts_.assign(static_cast<std::size_t>(height), {});
+    return {};
+  }
+
+  // Passes for the next frames (1 = plain per-pixel evaluation). No allocation.
+  [[nodiscard]] status set_passes(std::uint32_t passes) {
+    if (passes == 0 || passes > options_.max_passes)
+      return make_error(errc::bad_parameter, no_element, "upsampler: passes ", passes, " outside [1, max_passes = ",
+                        options_.max_passes, "]");
+    options_.passes = passes;
+    return {};
+  }
+
+  // Renders one frame into `out` (row-major, width·height pixels, pixel (x, y) at y·width + x),
+  // out[i] = src.shade(sample, x, y) for the final I-Buffer sample of each pixel.
+  // Preconditions: out.size() == width·height (else errc::bad_size, nothing written).
+  // Complexity: E·(cost of evaluate) + W·H·(cost of interpolate + shade) over the executor;
+  // E ≈ (W·H)/4^(passes−1) + (cluster and shadow boundary samples). Allocation: none.
+  // Thread-safety: src's const members are called concurrently (see sample_source.hpp).
+  // Output is bit-identical for every executor and thread count.
+  template <class S, class Pixel, class E>
+  [[nodiscard]] status render(const S& src, std::span<Pixel> out, E&& exec) {
+    static_assert(check_sample_source<S>());
+    static_assert(check_executor<std::remove_cvref_t<E>>());
+    static_assert(std::same_as<typename S::sample_type, Sample>,
+                  "infolerp: the sample source's sample_type differs from the upsampler's Sample");
+    static_assert(std::is_assignable_v<Pixel&, pixel_type_of<S>>,
+                  "infolerp: the output pixel type cannot be assigned the source's shade() result");
+    const std::size_t pixels = static_cast<std::size_t>(width_) * height_;
+    if (out.size() != pixels)
+      return make_error(errc::bad_size, no_element, "upsampler: output has ", out.size(), " pixels, image ",
+                        width_, "x", height_, " needs ", pixels);
+
+    const auto frame_start = Clock::now();
+    stats_ = {};
+    stats_.passes = options_.passes;
+    stats_.width = width_;
+    stats_.height = height_;
+    for (std::uint32_t k = 0; k < options_.passes; ++k) {
+      const std::uint32_t d = options_.passes - 1 - k;  // passes before the last
+      const auto pass_start = Clock::now();
+      if (k == 0) {
+        run_rows(exec, d, [&](std::uint32_t j, std::array<std::size_t, 3>& counts) {
+          evaluate_row(src, d, j, out, counts);
+        });
+      } else {
+        run_rows(exec, d, [&](std::uint32_t j, std::array<std::size_t, 3>& counts) {
+          upsample_row(src, d, j, out, counts);
+        });
+      }
+      pass_stats& ps = stats_.pass[k];
+      ps.width = extents_[d][0];
+      ps.height = extents_[d][1];
+      for (std::uint32_t j = 0; j < ps.height; ++j) {
+        ps.evaluated += row_counts_[j][0];
+        ps.interpolated += row_counts_[j][1];
+        ps.reused += row_counts_[j][2];
+      }
+      ps.seconds = seconds_since(pass_start);
+    }
+    stats_.seconds = seconds_since(frame_start);
+    return {};
+  }
+
+  // Serial render.
+  template <class S, class Pixel>
+  [[nodiscard]] status render(const S& src, std::span<Pixel> out) {
+    return render(src, out, serial_executor{});
+  }
+
+  [[nodiscard]] std::uint32_t width() const noexcept { return width_; }
+  [[nodiscard]] std::uint32_t height() const noexcept { return height_; }
+  [[nodiscard]] std::uint32_t passes() const noexcept { return options_.passes; }
+  [[nodiscard]] const upsampler_options& options() const noexcept { return options_; }
+  // Statistics of the last render.
+  [[nodiscard]] const upsample_stats& stats() const noexcept { return stats_; }
+  // The final I-Buffer of the last render (width·height samples, row-major); empty unless
+  // options.keep_ibuffer.
+  [[nodiscard]] std::span<const Sample> ibuffer() const noexcept { return levels_[0]; }
+  // R/I/E kind of each pixel in the last pass of the last render (empty unless record_kinds).
+  [[nodiscard]] std::span<const sample_kind> kinds() const noexcept { return kinds_; }
+  // Samples held by the pyramid (memory: this times sizeof(Sample)).
+  [[nodiscard]] std::size_t pyramid_samples() const noexcept {
+    std::size_t n = 0;
+    for (const auto& l : levels_) n += l.size();
+    return n;
+  }
+
+ private:
+  upsampler() = default;
+
+  static double seconds_since(typename Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  }
+
+  // Calls row_fn(j, counts_j) for every row of buffer d through the executor.
+  template <class E, class F>
+  void run_rows(E& exec, std::uint32_t d, const F& row_fn) {
+    const std::uint32_t rows = extents_[d][1];
+    exec.parallel_for(rows, options_.rows_per_task, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t j = begin; j < end; ++j) {
+        row_counts_[j] = {};
+        row_fn(static_cast<std::uint32_t>(j), row_counts_[j]);
+      }
+    });
+  }
+
+  // Stores sample s at (i, j) of buffer d; on the last pass (d == 0) also shades and records.
+  template <class S, class Pixel>
+  void store(const S& src, std::uint32_t d, std::uint32_t i, std::uint32_t j, Sample&& s, sample_kind kind,
+             std::span<Pixel> out, std::array<std::size_t, 3>& counts) {
+    ++counts[static_cast<std::size_t>(kind)];
+    const std::size_t idx = static_cast<std::size_t>(j) * extents_[d][0] + i;
+    if (d == 0) {
+      out[idx] = src.shade(s, i, j);
+      if (!kinds_.empty()) kinds_[idx] = kind;
+      if (!options_.keep_ibuffer) return;
+    }
+    levels_[d][idx] = std::move(s);
+  }
+
+  // First pass: every sample evaluated at pixel (i·2^d, j·2^d).
+  template <class S, class Pixel>
+  void evaluate_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
+                    std::array<std::size_t, 3>& counts) {
+    const std::uint32_t w = extents_[d][0];
+    for (std::uint32_t i = 0; i < w; ++i)
+      store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
+  }
+
+  // Later passes (Fig. 7): R at even (i, j), I or E between 2 (edge) or 4 (centre) samples.
+  template <class S, class Pixel>
+  void upsample_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
+                    std::array<std::size_t, 3>& counts) {
+    const std::uint32_t w = extents_[d][0];
+    const std::uint32_t pw = extents_[d + 1][0];
+    const Sample* prev = levels_[d + 1].data();
+    const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;            // previous row at or above
+    const Sample* r1 = (j & 1u) ? r0 + pw : r0;                               // previous row below (odd j)
+    for (std::uint32_t i = 0; i < w; ++i) {
+      const std::uint32_t a = i / 2;
+      if ((j & 1u) == 0) {
+        if ((i & 1u) == 0) {
+          store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
+        } else if (detail::may_interpolate(src, r0[a], r0[a + 1])) {
+          store(src, d, i, j, detail::source_interpolate(src, r0[a], r0[a + 1]), sample_kind::interpolated, out,
+                counts);
+        } else {
+          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
+        }
+      } else if ((i & 1u) == 0) {
+        if (detail::may_interpolate(src, r0[a], r1[a])) {
+          store(src, d, i, j, detail::source_interpolate(src, r0[a], r1[a]), sample_kind::interpolated, out, counts);
+        } else {
+          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
+        }
+      } else {
+        const Sample& s00 = r0[a];
+        const Sample& s10 = r0[a + 1];
+        const Sample& s01 = r1[a];
+        const Sample& s11 = r1[a + 1];
+        if (detail::may_interpolate(src, s00, s10) && detail::may_interpolate(src, s00, s01) &&
+            detail::may_interpolate(src, s00, s11)) {
+          store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out,
+                counts);
+        } else {
+          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
+        }
+      }
+    }
+  }
+
+  upsampler_options options_{};
+  std::uint32_t width_ = 0;
+  std::uint32_t height_ = 0;
+  std::array<std::array<std::uint32_t, 2>, max_upsample_passes> extents_{};  // [d] = {w, h}, d passes before the last
+  std::array<std::vector<Sample>, max_upsample_passes> levels_{};
+  std::vector<sample_kind> kinds_;
+  std::vector<std::array<std::size_t, 3>> row_counts_;  // per row of the current pass: E, I, R
+  upsample_stats stats_{};
+};
+
+// One-shot upsampling into out (width·height pixels) with a temporary pyramid.
+// Errors as upsampler::create and upsampler::render. Allocation: the pyramid (see create).
+// Prefer a kept `upsampler` for every-frame use.
+template <class S, class Pixel, class E>
+[[nodiscard]] status upsample(const S& src, std::uint32_t width, std::uint32_t height, std::span<Pixel> out,
+                              E&& exec, upsampler_options options = {}) {
+  static_assert(check_sample_source<S>());
+  options.max_passes = std::max(options.max_passes, options.passes);
+  auto u = upsampler<typename S::sample_type>::create(width, height, options);
+  if (!u) return u.error();
+  return u->render(src, out, exec);
+}
+
+}  // namespace infolerp

@@ -1,0 +1,174 @@
+#include "support/demo_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include "infolerp/mesh/geometry.hpp"
+#include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
+
+namespace infolerp::support {
+
+namespace {
+constexpr float pi = 3.14159265358979323846f;
+
+// A small integer hash (for per-brick colour variation that is the same on every run).
+float hash01(int x, int y) {
+  auto h = static_cast<std::uint32_t>(x) * 0x8da6b343u ^ static_cast<std::uint32_t>(y) * 0xd8163841u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return static_cast<float>(h & 0xffffu) / 65535.0f;
+}
+}  // namespace
+
+ray camera::primary_ray(float x, float y, int width, int height) const {
+  const glm::vec3 forward = glm::normalize(target - eye);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, up));
+  const glm::vec3 true_up = glm::cross(right, forward);
+  const float half_h = std::tan(0.5f * vertical_fov_degrees * pi / 180.0f);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * half_h * aspect;
+  const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * half_h;
+  ray r;
+  r.origin = eye;
+  r.direction = glm::normalize(forward + sx * right + sy * true_up);
+  return r;
+}
+
+glm::vec3 area_light::normal() const { return glm::normalize(glm::cross(edge_u, edge_v)); }
+float area_light::area() const { return glm::length(glm::cross(edge_u, edge_v)); }
+
+glm::vec3 albedo(const material& mat, glm::vec2 uv) {
+  const glm::vec2 p = uv * mat.repeat;
+  switch (mat.texture) {
+    case texture_kind::solid: return mat.color_a;
+    case texture_kind::checker: {
+      const auto cell = static_cast<long>(std::floor(p.x)) + static_cast<long>(std::floor(p.y));
+      return (cell & 1) == 0 ? mat.color_a : mat.color_b;
+    }
+    case texture_kind::brick: {
+      // Bricks twice as wide as tall; every other row shifted by half a brick; mortar lines.
+      const float row = std::floor(p.y);
+      const float shifted = p.x * 0.5f + (static_cast<long>(row) % 2 == 0 ? 0.0f : 0.5f);
+      const float col = std::floor(shifted);
+      const float fx = shifted - col, fy = p.y - row;
+      constexpr float mortar = 0.06f;
+      if (fx < mortar * 0.5f || fy < mortar) return mat.color_b;
+      const float shade = 0.85f + 0.3f * hash01(static_cast<int>(col), static_cast<int>(row));
+      return mat.color_a * shade;
+    }
+  }
+  return mat.color_a;
+}
+
+std::vector<glm::vec3> vertex_normals(const indexed_mesh& m) {
+  std::vector<glm::dvec3> sum(m.positions.size(), glm::dvec3(0.0));
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const glm::dvec3 n = area_vector(corners(m, t));  // length = 2·area: area weighting
+    const glm::uvec3 tri = m.triangles[t];
+    sum[tri.x] += n;
+    sum[tri.y] += n;
+    sum[tri.z] += n;
+  }
+  std::vector<glm::vec3> out(sum.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) {
+    const double len = glm::length(sum[v]);
+    out[v] = len > 0.0 && std::isfinite(len) ? glm::vec3(sum[v] / len) : glm::vec3(0.0f, 0.0f, 1.0f);
+  }
+  return out;
+}
+
+namespace {
+
+indexed_mesh transformed(const indexed_mesh& src, const glm::mat4& m) {
+  indexed_mesh out;
+  append(out, src, m);
+  return out;
+}
+
+// Loads the user's mesh (Y-up, as most OBJ/OFF/PLY files are: turned to this scene's Z-up) and
+// scales it so its largest extent is `size`, standing on the ground at `where` (x, y).
+result<indexed_mesh> load_fitted_mesh(const std::string& path, float size, glm::vec2 where) {
+  auto loaded = load_mesh(path);
+  if (!loaded) return loaded.error();
+  *loaded = transformed(*loaded, glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f)));
+  const bounding_box box = mesh_bounds(*loaded);
+  const glm::dvec3 extent = box.hi - box.lo;
+  const double largest = std::max({extent.x, extent.y, extent.z});
+  if (!(largest > 0.0) || !std::isfinite(largest))
+    return make_error(errc::degenerate_triangle, no_element, "mesh '", path, "' has no extent (or non-finite positions)");
+  const auto s = static_cast<float>(size / largest);
+  const glm::vec3 c(box.center());
+  const glm::vec3 base(c.x, c.y, static_cast<float>(box.lo.z));
+  glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(where, 0.0f));
+  m = glm::scale(m, glm::vec3(s));
+  m = glm::translate(m, -base);
+  indexed_mesh out = transformed(*loaded, m);
+  out.normals = vertex_normals(out);
+  return out;
+}
+
+}  // namespace
+
+result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options) {
+  std::vector<scene_object> objects;
+
+  // Ground: 16 x 16 units of bricks (48 rows).
+  objects.push_back({"ground", make_plane(options.ground_cells, options.ground_cells, 16.0f),
+                     {texture_kind::brick, {0.62f, 0.32f, 0.22f}, {0.8f, 0.78f, 0.72f}, {24.0f, 48.0f}, 0.0f}});
+
+  // UV sphere, poles on the Z axis: the checker shows the texture stretch toward the poles.
+  {
+    const glm::vec3 center{-1.7f, 0.4f, 1.1f};
+    indexed_mesh sphere = transformed(make_uv_sphere(options.sphere_slices, options.sphere_stacks, 1.1f),
+                                      glm::translate(glm::mat4(1.0f), center));
+    sphere.normals.resize(sphere.positions.size());
+    for (std::size_t v = 0; v < sphere.positions.size(); ++v)
+      sphere.normals[v] = glm::normalize(sphere.positions[v] - center);
+    objects.push_back({"uv sphere", std::move(sphere),
+                       {texture_kind::checker, {0.9f, 0.9f, 0.85f}, {0.15f, 0.3f, 0.6f}, {16.0f, 8.0f}, 0.4f}});
+  }
+
+  // Torus, tilted so that its hole and inner side show.
+  {
+    glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(1.5f, -0.6f, 0.75f));
+    m = glm::rotate(m, 0.6f, glm::vec3(1.0f, 0.3f, 0.0f));
+    indexed_mesh torus = transformed(make_torus(options.torus_major, options.torus_minor, 0.75f, 0.28f), m);
+    torus.normals = vertex_normals(torus);
+    objects.push_back({"torus", std::move(torus), {texture_kind::solid, {0.85f, 0.55f, 0.12f}, {}, {1.0f, 1.0f}, 0.6f}});
+  }
+
+  // Boxes (flat shaded): hard shadow casters.
+  {
+    indexed_mesh boxes;
+    append(boxes, make_box({0.1f, 1.6f, 0.0f}, {1.0f, 2.5f, 2.2f}));
+    append(boxes, make_box({2.4f, 0.9f, 0.0f}, {3.3f, 1.8f, 0.8f}));
+    append(boxes, make_box({-3.6f, -2.2f, 0.0f}, {-2.8f, -1.4f, 0.6f}));
+    append(boxes, make_box({-0.6f, -0.4f, 0.0f}, {-0.2f, 0.0f, 1.4f}));
+    objects.push_back({"boxes", std::move(boxes), {texture_kind::solid, {0.55f, 0.6f, 0.55f}, {}, {1.0f, 1.0f}, 0.0f}});
+  }
+
+  if (!options.mesh_path.empty()) {
+    auto user = load_fitted_mesh(options.mesh_path, options.mesh_size, {0.2f, -2.4f});
+    if (!user) return user.error();
+    objects.push_back({options.mesh_path, std::move(*user), {texture_kind::solid, {0.75f, 0.72f, 0.68f}, {}, {1.0f, 1.0f}, 0.3f}});
+  }
+
+  embree_scene tracer{device};
+  for (const auto& object : objects) {
+    auto id = tracer.add_mesh(object.mesh);
+    if (!id) return id.error();
+  }
+  if (auto s = tracer.commit(); !s) return s;
+
+  demo_scene scene{std::move(tracer)};
+  scene.objects = std::move(objects);
+  scene.view = {{6.5f, -8.5f, 5.0f}, {0.0f, 0.0f, 0.7f}, {0.0f, 0.0f, 1.0f}, 36.0f};
+  scene.sun = {glm::normalize(glm::vec3(0.6f, -0.35f, 0.75f)), {1.0f, 0.92f, 0.8f}};
+  scene.area = {{-1.2f, -1.2f, 4.5f}, {0.0f, 2.4f, 0.0f}, {2.4f, 0.0f, 0.0f}, {2.2f, 2.2f, 2.4f}};
+  return scene;
+}
+
+}  // namespace infolerp::support

@@ -1,0 +1,103 @@
+#pragma once
+// The built-in demo scene (procedural, no downloads): a brick-textured ground plane, a
+// checker-textured UV sphere (its texture stretches toward the poles), a torus, boxes that cast
+// hard shadows, an optional user mesh (--mesh FILE), a pinhole camera, a sun (hard shadow) and
+// a rectangular area light (soft shadow). Z is up. Shared by the demo, tests and benchmarks.
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/tracer.hpp"
+#include "infolerp/mesh/adaptors.hpp"
+#include "support/embree_tracer.hpp"
+
+namespace infolerp::support {
+
+// A pinhole camera that looks from eye at target.
+struct camera {
+  glm::vec3 eye{0.0f, -10.0f, 3.0f};
+  glm::vec3 target{0.0f};
+  glm::vec3 up{0.0f, 0.0f, 1.0f};
+  float vertical_fov_degrees = 40.0f;
+
+  // The ray through image point (x, y) of a width x height image, in pixels from the top-left
+  // corner (pixel (i, j) has its centre at (i + 0.5, j + 0.5)). Unit direction, tnear 0.
+  ray primary_ray(float x, float y, int width, int height) const;
+};
+
+// A directional light with hard shadows. direction points toward the sun (unit length).
+struct sun_light {
+  glm::vec3 direction{0.0f, 0.0f, 1.0f};
+  glm::vec3 radiance{1.0f};  // irradiance on a surface facing the sun
+};
+
+// A one-sided rectangle corner + a·edge_u + b·edge_v, (a, b) in [0,1]², emitting toward
+// cross(edge_u, edge_v).
+struct area_light {
+  glm::vec3 corner{0.0f};
+  glm::vec3 edge_u{1.0f, 0.0f, 0.0f};
+  glm::vec3 edge_v{0.0f, 1.0f, 0.0f};
+  glm::vec3 radiance{1.0f};
+
+  glm::vec3 point(float a, float b) const { return corner + a * edge_u + b * edge_v; }
+  glm::vec3 center() const { return point(0.5f, 0.5f); }
+  glm::vec3 normal() const;  // unit, the emitting side
+  float area() const;
+};
+
+// Procedural textures looked up through interpolated texcoords.
+enum class texture_kind : std::uint8_t { solid, checker, brick };
+struct material {
+  texture_kind texture = texture_kind::solid;
+  glm::vec3 color_a{0.7f};              // solid colour, checker even cells, bricks
+  glm::vec3 color_b{0.2f};              // checker odd cells, mortar
+  glm::vec2 repeat{1.0f};               // texture cells per unit of texcoord (u, v)
+  float specular = 0.0f;                // Blinn-Phong weight (white highlight)
+};
+// Albedo of `mat` at texcoord uv (pure, deterministic).
+glm::vec3 albedo(const material& mat, glm::vec2 uv);
+
+// One object of the scene: objects[g] is the tracer's geometry g. Meshes with per-vertex normals
+// are shaded smooth, the others flat; texcoords, when present, drive the material's texture.
+struct scene_object {
+  std::string name;
+  indexed_mesh mesh;
+  material mat;
+};
+
+struct demo_scene {
+  std::vector<scene_object> objects;
+  embree_scene tracer;  // committed; geometry ids are indices into objects
+  camera view;
+  sun_light sun;
+  area_light area;
+  glm::vec3 sky_zenith{0.25f, 0.45f, 0.85f};
+  glm::vec3 sky_horizon{0.75f, 0.85f, 0.95f};
+  glm::vec3 ambient{0.25f, 0.28f, 0.34f};  // sky light reaching an unoccluded surface (scaled by AO)
+  float ao_radius = 1.5f;               // ambient-occlusion rays look this far
+  float ray_offset = 1e-3f;             // secondary rays start this far off the surface
+
+  explicit demo_scene(embree_scene t) : tracer(std::move(t)) {}
+};
+
+struct demo_scene_options {
+  std::string mesh_path;          // a real mesh (OFF/OBJ/PLY ... via assimp) to add; empty: none
+  float mesh_size = 1.8f;         // the user mesh is scaled so its largest extent is this
+  unsigned sphere_slices = 64;    // UV sphere tessellation
+  unsigned sphere_stacks = 32;
+  unsigned torus_major = 64;      // torus tessellation
+  unsigned torus_minor = 24;
+  unsigned ground_cells = 16;     // ground plane quads per side
+};
+
+// Builds the scene on `device` and commits its tracer. Errors: the user mesh cannot be loaded
+// (the message names the file) or has no triangles Embree accepts.
+result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options = {});
+
+// Area-weighted vertex normals (unit; (0,0,1) for a vertex whose triangles have no area).
+std::vector<glm::vec3> vertex_normals(const indexed_mesh& m);
+
+}  // namespace infolerp::support

@@ -1,0 +1,126 @@
+#pragma once
+// The demo scene as an I-Buffer sample source (include/infolerp/upsample/sample_source.hpp),
+// shared by the demo's upsampler stage and the time-against-error harness:
+//   evaluate(x, y): the reference shader's full evaluation of pixel (x, y) (primary ray, hard
+//                   shadow, soft shadow, AO) stored in the default record surface_sample<2>:
+//                   position, normal, texcoords, cluster id, sun bit, occlusion {ao, soft}.
+//   shade(s, x, y): the reference shader's shade() of that record; the view direction is the
+//                   pixel's primary ray and the material is the cluster's object.
+// Evaluated pixels reproduce the reference render (up to the renormalised normal's last bit).
+//
+// Clusterings: STAND-INS until the clustering of include/infolerp/cluster/ lands in main:
+//   cluster_by_object   one cluster per scene object (geometry id)
+//   cluster_by_normal   per object, face normals binned on a cube map (cells×cells per face),
+//                       split further at texcoord halves so that no cluster spans a UV seam.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+#include <glm/geometric.hpp>
+#include "infolerp/mesh/geometry.hpp"
+#include "infolerp/upsample/sample_source.hpp"
+#include "support/demo_scene.hpp"
+#include "support/image.hpp"
+#include "support/reference_shader.hpp"
+
+namespace infolerp::support {
+
+struct scene_clustering {
+  std::string name;
+  std::vector<std::vector<std::uint32_t>> ids;  // [geometry][triangle] -> global cluster id
+  std::vector<std::uint32_t> geometry_of;       // [cluster] -> geometry
+  std::size_t count() const { return geometry_of.size(); }
+};
+
+inline scene_clustering cluster_by_object(const demo_scene& scene) {
+  scene_clustering c{"object", {}, {}};
+  for (std::uint32_t g = 0; g < scene.objects.size(); ++g) {
+    c.ids.emplace_back(scene.objects[g].mesh.triangle_count(), g);
+    c.geometry_of.push_back(g);
+  }
+  return c;
+}
+
+inline scene_clustering cluster_by_normal(const demo_scene& scene, int cells) {
+  scene_clustering c{"normal" + std::to_string(cells), {}, {}};
+  for (std::uint32_t g = 0; g < scene.objects.size(); ++g) {
+    const indexed_mesh& m = scene.objects[g].mesh;
+    const auto normals = face_normals(m);
+    std::vector<std::uint32_t> local(m.triangle_count());
+    std::vector<std::uint32_t> remap(static_cast<std::size_t>(6 * cells * cells * 4), invalid_id);
+    for (std::size_t t = 0; t < local.size(); ++t) {
+      const glm::vec3 n = normals[t];
+      const glm::vec3 a = glm::abs(n);
+      const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+      const float major = std::max(a[axis], 1e-12f);
+      const int face = 2 * axis + (n[axis] < 0.0f ? 1 : 0);
+      const float u = n[(axis + 1) % 3] / major, v = n[(axis + 2) % 3] / major;  // in [-1, 1]
+      auto cell = [&](float w) { return std::clamp(static_cast<int>((w + 1.0f) * 0.5f * static_cast<float>(cells)), 0, cells - 1); };
+      int uv_half = 0;
+      if (m.has_texcoords()) {
+        const glm::vec2 tc = (m.texcoord(t, 0) + m.texcoord(t, 1) + m.texcoord(t, 2)) / 3.0f;
+        uv_half = (tc.x - std::floor(tc.x) >= 0.5f ? 1 : 0) + (tc.y - std::floor(tc.y) >= 0.5f ? 2 : 0);
+      }
+      const std::size_t key = static_cast<std::size_t>(((face * cells + cell(u)) * cells + cell(v)) * 4 + uv_half);
+      if (remap[key] == invalid_id) {
+        remap[key] = static_cast<std::uint32_t>(c.geometry_of.size());
+        c.geometry_of.push_back(g);
+      }
+      local[t] = remap[key];
+    }
+    c.ids.push_back(std::move(local));
+  }
+  return c;
+}
+
+using demo_sample = surface_sample<2, true>;  // occlusion = {ambient occlusion, soft-shadow visibility}
+
+struct demo_ibuffer_source {
+  using sample_type = demo_sample;
+  const reference_shader* shader = nullptr;
+  const scene_clustering* clusters = nullptr;
+  int width = 0;
+  int height = 0;
+
+  demo_sample evaluate(std::uint32_t x, std::uint32_t y) const {
+    std::uint64_t rays = 0;
+    const shading_inputs in = shader->evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f,
+                                                     width, height, rays);
+    return from_inputs(in);
+  }
+  demo_sample from_inputs(const shading_inputs& in) const {
+    demo_sample s;
+    if (!in.hit()) return s;
+    s.position = in.position;
+    s.normal = in.normal;
+    s.texcoord = in.uv;
+    s.cluster = clusters->ids[in.geometry][in.triangle];
+    s.lights = in.light_bits;
+    s.occlusion = {in.ao, in.soft_shadow};
+    return s;
+  }
+  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
+    shading_inputs in;
+    in.view = glm::normalize(
+        shader->scene().view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
+    if (s.background()) return in;
+    in.position = s.position;
+    const float len = glm::length(s.normal);
+    in.normal = len > 0.0f ? s.normal / len : s.normal;
+    in.uv = s.texcoord;
+    in.geometry = clusters->geometry_of[s.cluster];
+    in.light_bits = s.lights;
+    in.ao = s.occlusion[0];
+    in.soft_shadow = s.occlusion[1];
+    return in;
+  }
+  glm::vec3 shade(const demo_sample& s, std::uint32_t x, std::uint32_t y) const { return shader->shade(to_inputs(s, x, y)); }
+};
+
+// Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.
+inline float display_luma(glm::vec3 linear) {
+  return (0.2126f * to_srgb8(linear.x) + 0.7152f * to_srgb8(linear.y) + 0.0722f * to_srgb8(linear.z)) / 255.0f;
+}
+
+}  // namespace infolerp::support

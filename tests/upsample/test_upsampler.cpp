@@ -1,0 +1,380 @@
+// Tests for include/infolerp/upsample/upsampler.hpp and sample_source.hpp with synthetic sample
+// sources (no ray tracer): exact reconstruction where the paper's interpolation is exact, the
+// R/I/E pattern of Fig. 7, boundaries, any output size, every pixel written, determinism.
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+#include <glm/vec4.hpp>
+#include "infolerp/upsample/upsampler.hpp"
+#include "support/thread_pool.hpp"
+
+// Counts heap allocations, to show that rendering allocates nothing.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+namespace {
+std::atomic<std::size_t> g_allocations{0};
+}
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+using infolerp::sample_kind;
+using sample = infolerp::surface_sample<2, true>;
+
+// A convex-region scene: pixels are split by straight lines into regions (cluster boundary,
+// shadow boundary, background); inside each region every attribute is linear in (x, y) with
+// dyadic coefficients, so float midpoints are exact. Midpoints and centres of samples in one
+// convex region lie in that region, hence the upsampler must reproduce the evaluated image
+// exactly, and any pixel whose sources straddle a boundary must be evaluated.
+struct region_source {
+  using sample_type = sample;
+  bool cluster_edge = true;     // x + y/2 < 37 → cluster 0, else cluster 1
+  bool shadow_edge = true;      // 3x − y < 20 → light 0 visible
+  bool background_edge = false; // y > 300 → background
+  mutable std::atomic<std::uint32_t> max_x{0}, max_y{0}, calls{0};
+
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    calls.fetch_add(1, std::memory_order_relaxed);
+    std::uint32_t mx = max_x.load();
+    while (xi > mx && !max_x.compare_exchange_weak(mx, xi)) {}
+    std::uint32_t my = max_y.load();
+    while (yi > my && !max_y.compare_exchange_weak(my, yi)) {}
+    const float x = static_cast<float>(xi), y = static_cast<float>(yi);
+    sample s;
+    if (background_edge && yi > 300) return s;  // background: cluster invalid_id
+    s.cluster = (cluster_edge && x + 0.5f * y >= 37.0f) ? 1u : 0u;
+    s.lights = (shadow_edge && 3.0f * x - y >= 20.0f) ? 0u : 1u;
+    const float k = static_cast<float>(s.cluster * 2u + s.lights);  // region-specific coefficients
+    s.position = {0.25f * x + k, 0.5f * y - k, 1.0f + 0.125f * x + 0.0625f * y};
+    s.normal = {0.0f, 1.0f, 0.03125f * x * (k + 1.0f)};
+    s.texcoord = {0.0078125f * x, 0.00390625f * y * (k + 1.0f)};
+    s.occlusion = {0.5f + 0.001953125f * x, 0.25f + k * 0.0009765625f * y};
+    return s;
+  }
+  glm::vec4 shade(const sample& s, std::uint32_t, std::uint32_t) const {
+    return {s.position.x + s.texcoord.x, s.occlusion[0], static_cast<float>(s.lights), static_cast<float>(s.cluster)};
+  }
+};
+
+bool same_bits(const sample& a, const sample& b) {
+  return a.position == b.position && a.normal == b.normal && a.texcoord == b.texcoord && a.cluster == b.cluster &&
+         a.lights == b.lights && a.occlusion == b.occlusion;
+}
+
+template <class Src>
+std::vector<glm::vec4> poisoned(std::uint32_t w, std::uint32_t h) {
+  return std::vector<glm::vec4>(static_cast<std::size_t>(w) * h, glm::vec4(std::numeric_limits<float>::quiet_NaN()));
+}
+
+infolerp::upsampler<sample> make(std::uint32_t w, std::uint32_t h, std::uint32_t passes, std::uint32_t max_passes = 5) {
+  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = max_passes, .keep_ibuffer = true});
+  REQUIRE(u.ok());
+  return std::move(*u);
+}
+
+struct two_clusters {
+  using sample_type = sample;
+  sample evaluate(std::uint32_t x, std::uint32_t) const {
+    sample s;
+    s.cluster = x < 3 ? 0u : 1u;
+    s.lights = 1;
+    s.texcoord = {static_cast<float>(x), 0.0f};
+    return s;
+  }
+  float shade(const sample& s, std::uint32_t, std::uint32_t) const { return s.texcoord.x; }
+};
+
+struct wavy {
+  using sample_type = sample;
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    const float x = static_cast<float>(xi), y = static_cast<float>(yi);
+    sample s;
+    const float r = std::sqrt((x - 130.0f) * (x - 130.0f) + (y - 90.0f) * (y - 90.0f));
+    if (r > 120.0f) return s;
+    s.cluster = static_cast<std::uint32_t>(std::sin(0.05f * x) * 3.0f + std::cos(0.07f * y) * 3.0f + 6.0f);
+    s.lights = (x * 0.3f + std::sin(y * 0.1f) * 9.0f > 40.0f) ? 1u : 3u;
+    s.position = {x * 0.1f, std::sin(y * 0.01f), r};
+    s.normal = {std::cos(x * 0.013f), 1.0f, std::sin(y * 0.017f)};
+    s.texcoord = {x / 300.0f, y / 7.0f};
+    s.occlusion = {1.0f / (1.0f + r), std::sqrt(x + y)};
+    return s;
+  }
+  glm::vec4 shade(const sample& s, std::uint32_t, std::uint32_t) const {
+    return {s.position.x * s.occlusion[0], s.texcoord.y, s.normal.z, static_cast<float>(s.lights)};
+  }
+};
+
+using flat = infolerp::surface_sample<2, false>;
+struct no_lights {
+  using sample_type = flat;
+  region_source inner;
+  flat evaluate(std::uint32_t x, std::uint32_t y) const {
+    const sample s = inner.evaluate(x, y);
+    flat f;
+    f.position = s.position;
+    f.normal = s.normal;
+    f.texcoord = s.texcoord;
+    f.cluster = s.cluster;
+    f.occlusion = s.occlusion;
+    return f;
+  }
+  float shade(const flat& s, std::uint32_t, std::uint32_t) const { return s.position.x; }
+};
+
+struct bg_sample {
+  float value = 0.0f;
+  bool miss = false;
+  bool background() const { return miss; }
+};
+struct careless {
+  using sample_type = bg_sample;
+  bg_sample evaluate(std::uint32_t x, std::uint32_t y) const {
+    return {static_cast<float>(x) * 0.5f + static_cast<float>(y), 2 * x + y > 151};  // half-plane of background
+  }
+  bool compatible(const bg_sample&, const bg_sample&) const { return true; }
+  bg_sample interpolate(const bg_sample& a, const bg_sample& b) const { return {0.5f * (a.value + b.value), a.miss}; }
+  bg_sample interpolate(const bg_sample& a, const bg_sample& b, const bg_sample& c, const bg_sample& d) const {
+    return {0.25f * ((a.value + b.value) + (c.value + d.value)), a.miss};
+  }
+  float shade(const bg_sample& s, std::uint32_t, std::uint32_t) const { return s.miss ? -1.0f : s.value; }
+};
+
+}  // namespace
+
+TEST_CASE("a single cluster with attributes linear in screen space reconstructs exactly", "[upsample]") {
+  region_source src;
+  src.cluster_edge = false;
+  src.shadow_edge = false;
+  const std::uint32_t w = 97, h = 66;
+  for (std::uint32_t passes = 1; passes <= 5; ++passes) {
+    auto up = make(w, h, passes);
+    auto out = poisoned<region_source>(w, h);
+    REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
+    const auto ib = up.ibuffer();
+    for (std::uint32_t y = 0; y < h; ++y)
+      for (std::uint32_t x = 0; x < w; ++x) REQUIRE(same_bits(ib[y * w + x], src.evaluate(x, y)));
+    // One cluster: only the first pass evaluates (the cropped border included).
+    const auto& st = up.stats();
+    CHECK(st.evaluated() == st.pass[0].evaluated);
+    const std::uint32_t step = 1u << (passes - 1);
+    CHECK(st.pass[0].width == (w - 1 + step - 1) / step + 1);
+    CHECK(st.pass[0].height == (h - 1 + step - 1) / step + 1);
+  }
+}
+
+TEST_CASE("R/I/E pattern of Fig. 7: 2x2 start, three passes, two clusters", "[upsample]") {
+  // 5x5 image, cluster 0 for x < 3, cluster 1 for x >= 3 (a vertical boundary).
+  two_clusters src;
+  auto up = make(5, 5, 3);
+  std::vector<float> out(25, -1.0f);
+  REQUIRE(up.render(src, std::span<float>(out)).ok());
+  const auto& st = up.stats();
+  REQUIRE(st.passes == 3);
+  // Pass 1: 2x2, all evaluated.
+  CHECK(st.pass[0].width == 2);
+  CHECK(st.pass[0].evaluated == 4);
+  // Pass 2: 3x3. Corners R; (2,0),(2,2),(2,4) straddle the boundary → E; (0,2),(4,2) → I.
+  CHECK(st.pass[1].width == 3);
+  CHECK(st.pass[1].reused == 4);
+  CHECK(st.pass[1].interpolated == 2);
+  CHECK(st.pass[1].evaluated == 3);
+  // Pass 3: 5x5, worked out by hand.
+  const char* expected[5] = {"RIRER", "IIIEI", "RIRER", "IIIEI", "RIRER"};
+  const auto kinds = up.kinds();
+  REQUIRE(kinds.size() == 25);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 5; ++x) {
+      const char c = "EIR"[static_cast<int>(kinds[static_cast<std::size_t>(y * 5 + x)])];
+      INFO("pixel " << x << "," << y);
+      CHECK(c == expected[y][x]);
+    }
+  CHECK(st.pass[2].reused == 9);
+  CHECK(st.pass[2].interpolated == 11);
+  CHECK(st.pass[2].evaluated == 5);
+  for (int x = 0; x < 5; ++x) CHECK(out[static_cast<std::size_t>(x)] == static_cast<float>(x));
+}
+
+TEST_CASE("cluster, shadow and background boundaries are evaluated, not interpolated", "[upsample]") {
+  region_source src;
+  src.background_edge = true;
+  const std::uint32_t w = 320, h = 340;
+  for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+    auto up = make(w, h, passes);
+    auto out = poisoned<region_source>(w, h);
+    REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
+    const auto ib = up.ibuffer();
+    // Convex regions: exact everywhere, so no pixel got another region's cluster, light bits or values.
+    std::size_t wrong = 0;
+    for (std::uint32_t y = 0; y < h; ++y)
+      for (std::uint32_t x = 0; x < w; ++x) wrong += same_bits(ib[y * w + x], src.evaluate(x, y)) ? 0 : 1;
+    CHECK(wrong == 0);
+    CHECK(up.stats().evaluated() > up.stats().pass[0].evaluated);  // the boundaries cost evaluations
+  }
+  SECTION("without the light-bit test the shadow boundary is interpolated over") {
+    // Same scene, light bits compiled out of the record: the shadow edge is invisible to the
+    // upsampler, so some pixels near it get interpolated wrong values.
+    static_assert(sizeof(flat) < sizeof(sample));
+    no_lights nl;
+    auto u = infolerp::upsampler<flat>::create(w, h, {.passes = 4, .keep_ibuffer = true});
+    REQUIRE(u.ok());
+    std::vector<float> out(static_cast<std::size_t>(w) * h);
+    REQUIRE(u->render(nl, std::span<float>(out)).ok());
+    std::size_t wrong = 0;
+    for (std::uint32_t y = 0; y < h; ++y)
+      for (std::uint32_t x = 0; x < w; ++x) wrong += out[y * w + x] == nl.evaluate(x, y).position.x ? 0 : 1;
+    CHECK(wrong > 0);
+  }
+}
+
+TEST_CASE("background is never interpolated with geometry, even if compatible() says yes", "[upsample]") {
+  careless src;
+  static_assert(infolerp::check_sample_source<careless>());
+  auto u = infolerp::upsampler<bg_sample>::create(90, 70, {.passes = 3, .keep_ibuffer = true});
+  REQUIRE(u.ok());
+  std::vector<float> out(90 * 70);
+  REQUIRE(u->render(src, std::span<float>(out)).ok());
+  const auto ib = u->ibuffer();
+  const auto kinds = u->kinds();
+  // Both sides of the edge are convex, so a pixel is right unless it was interpolated between
+  // background and geometry, which compatible() alone would have allowed.
+  std::size_t wrong = 0;
+  for (std::uint32_t y = 0; y < 70; ++y)
+    for (std::uint32_t x = 0; x < 90; ++x) wrong += ib[y * 90 + x].miss == src.evaluate(x, y).miss ? 0 : 1;
+  CHECK(wrong == 0);
+  std::size_t evaluated_late = 0;
+  for (auto k : kinds) evaluated_late += k == sample_kind::evaluated;
+  CHECK(evaluated_late > 0);
+}
+
+TEST_CASE("any output size: every pixel written, exact on one cluster, bounded overhang", "[upsample]") {
+  region_source src;
+  src.cluster_edge = false;
+  src.shadow_edge = false;
+  const std::uint32_t sizes[][2] = {{1, 1}, {2, 2}, {1024, 768}, {1025, 1025}, {3, 1}, {1, 7}};
+  for (const auto& sz : sizes) {
+    const std::uint32_t w = sz[0], h = sz[1];
+    for (std::uint32_t passes : {1u, 2u, 4u, 5u}) {
+      INFO(w << "x" << h << " passes " << passes);
+      auto up = make(w, h, passes);
+      src.max_x = 0;
+      src.max_y = 0;
+      auto out = poisoned<region_source>(w, h);
+      REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
+      std::size_t unwritten = 0, wrong = 0;
+      for (std::uint32_t y = 0; y < h; ++y)
+        for (std::uint32_t x = 0; x < w; ++x) {
+          const glm::vec4 p = out[static_cast<std::size_t>(y) * w + x];
+          unwritten += std::isnan(p.x) || std::isnan(p.y) || std::isnan(p.z) || std::isnan(p.w);
+          wrong += p == src.shade(src.evaluate(x, y), x, y) ? 0 : 1;
+        }
+      CHECK(unwritten == 0);
+      CHECK(wrong == 0);
+      const std::uint32_t step = 1u << (passes - 1);
+      CHECK(src.max_x.load() < w + step - 1);
+      CHECK(src.max_y.load() < h + step - 1);
+      // Memory: about 4/3 of the full-resolution buffer with the final I-Buffer kept, 1/3 without.
+      const double full = static_cast<double>(w) * h;
+      CHECK(static_cast<double>(up.pyramid_samples()) <= 4.0 / 3.0 * full + 4.0 * (w + h) + 4.0 * 5);
+      auto lean = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5});
+      REQUIRE(lean.ok());
+      CHECK(static_cast<double>(lean->pyramid_samples()) <= 1.0 / 3.0 * full + 4.0 * (w + h) + 4.0 * 5);
+      CHECK(lean->ibuffer().empty());
+      // Per-pass counts add up to the pass size.
+      const auto& st = up.stats();
+      for (std::uint32_t p = 0; p < st.passes; ++p)
+        CHECK(st.pass[p].reused + st.pass[p].interpolated + st.pass[p].evaluated ==
+              static_cast<std::size_t>(st.pass[p].width) * st.pass[p].height);
+      CHECK(st.pass[st.passes - 1].width == w);
+      CHECK(st.pass[st.passes - 1].height == h);
+    }
+  }
+}
+
+TEST_CASE("rendering allocates nothing once the upsampler exists", "[upsample]") {
+  region_source src;
+  auto up = make(200, 150, 4);
+  std::vector<glm::vec4> out(200 * 150);
+  REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
+  const std::size_t before = g_allocations.load();
+  for (std::uint32_t passes : {4u, 2u, 5u, 1u}) {
+    REQUIRE(up.set_passes(passes).ok());
+    REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
+  }
+  CHECK(g_allocations.load() == before);
+}
+
+TEST_CASE("serial and parallel outputs are bit-identical", "[upsample]") {
+  // Curved cluster boundaries and non-dyadic attributes, so rounding would show any difference.
+  wavy src;
+  const std::uint32_t w = 257, h = 190;
+  for (std::uint32_t passes : {1u, 3u, 5u}) {
+    auto serial = make(w, h, passes);
+    std::vector<glm::vec4> ref(static_cast<std::size_t>(w) * h);
+    REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
+    if (passes > 1) CHECK(serial.stats().evaluated() > serial.stats().pass[0].evaluated);
+    auto compare = [&](auto&& exec) {
+      auto up = make(w, h, passes);
+      std::vector<glm::vec4> out(ref.size(), glm::vec4(-7.0f));
+      REQUIRE(up.render(src, std::span<glm::vec4>(out), exec).ok());
+      CHECK(std::memcmp(out.data(), ref.data(), out.size() * sizeof(glm::vec4)) == 0);
+      CHECK(std::equal(up.kinds().begin(), up.kinds().end(), serial.kinds().begin()));
+      for (std::uint32_t p = 0; p < passes; ++p) {
+        CHECK(up.stats().pass[p].evaluated == serial.stats().pass[p].evaluated);
+        CHECK(up.stats().pass[p].interpolated == serial.stats().pass[p].interpolated);
+      }
+    };
+    compare(infolerp::support::thread_pool_executor{1});
+    compare(infolerp::support::thread_pool_executor{2});
+    compare(infolerp::support::thread_pool_executor{8});
+    compare(infolerp::openmp_executor{});
+    compare(infolerp::openmp_executor{.threads = 3});
+  }
+}
+
+TEST_CASE("bad input gives a clear status", "[upsample]") {
+  using up_t = infolerp::upsampler<sample>;
+  auto zero = up_t::create(0, 0);
+  REQUIRE_FALSE(zero.ok());
+  CHECK(zero.error().code() == infolerp::errc::empty_input);
+  CHECK(zero.error().message().find("0x0") != std::string::npos);
+  auto no_passes = up_t::create(16, 16, {.passes = 1, .max_passes = 0});
+  REQUIRE_FALSE(no_passes.ok());
+  CHECK(no_passes.error().code() == infolerp::errc::bad_parameter);
+  CHECK(no_passes.error().message().find("max_passes 0") != std::string::npos);
+  auto zero_passes = up_t::create(16, 16, {.passes = 0});
+  REQUIRE_FALSE(zero_passes.ok());
+  CHECK(zero_passes.error().message().find("passes 0") != std::string::npos);
+  auto too_many = up_t::create(16, 16, {.passes = 5, .max_passes = 4});
+  REQUIRE_FALSE(too_many.ok());
+  CHECK(too_many.error().code() == infolerp::errc::bad_parameter);
+
+  auto up = make(16, 8, 3);
+  CHECK(up.set_passes(6).code() == infolerp::errc::bad_parameter);
+  CHECK(up.passes() == 3);
+  region_source src;
+  std::vector<glm::vec4> small(16 * 8 - 1, glm::vec4(5.0f));
+  const auto s = up.render(src, std::span<glm::vec4>(small));
+  CHECK(s.code() == infolerp::errc::bad_size);
+  CHECK(src.calls.load() == 0);
+  CHECK(small[0] == glm::vec4(5.0f));
+  CHECK(up.resize(0, 3).code() == infolerp::errc::empty_input);
+  CHECK(up.width() == 16);
+
+  // The one-shot form validates the same way.
+  std::vector<glm::vec4> out(4);
+  CHECK(infolerp::upsample(src, 2, 2, std::span<glm::vec4>(out), infolerp::serial_executor{}).ok());
+  CHECK(infolerp::upsample(src, 0, 2, std::span<glm::vec4>(out), infolerp::serial_executor{}).code() ==
+        infolerp::errc::empty_input);
+}
