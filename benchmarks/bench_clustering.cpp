@@ -5,9 +5,8 @@
 //                                   time, JS abs error vs exact, adjusted Rand index vs exact.
 //   BM_VisibilityChannel_Total / BM_VisibilityChannel_RaysOnly   the channel against the raw time
 //                                   of its own rays through the same tracer. Goal ≤ 1.3×.
-// The Embree tracer below is a stand-in until tests/support/embree_tracer.hpp reaches main.
+// Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 #include <benchmark/benchmark.h>
-#include <embree3/rtcore.h>
 #include <sys/resource.h>
 
 #include <chrono>
@@ -18,53 +17,13 @@
 #include <numeric>
 #include <vector>
 #include "infolerp/cluster/cluster_mesh.hpp"
+#include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
 using namespace infolerp;
 
 namespace {
-
-class bench_embree_tracer {
- public:
-  explicit bench_embree_tracer(const indexed_mesh& m) : device_(rtcNewDevice("threads=1")), scene_(rtcNewScene(device_)) {
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), m.positions.size()));
-    for (std::size_t i = 0; i < m.positions.size(); ++i)
-      for (int k = 0; k < 3; ++k) v[3 * i + static_cast<std::size_t>(k)] = m.positions[i][k];
-    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(unsigned), m.triangles.size()));
-    for (std::size_t i = 0; i < m.triangles.size(); ++i)
-      for (int k = 0; k < 3; ++k) idx[3 * i + static_cast<std::size_t>(k)] = m.triangles[i][k];
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene_, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene_);
-  }
-  ~bench_embree_tracer() {
-    rtcReleaseScene(scene_);
-    rtcReleaseDevice(device_);
-  }
-  bench_embree_tracer(const bench_embree_tracer&) = delete;
-  bench_embree_tracer& operator=(const bench_embree_tracer&) = delete;
-
-  bool occluded(const ray& r) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay rr{};
-    rr.org_x = r.origin.x, rr.org_y = r.origin.y, rr.org_z = r.origin.z, rr.tnear = r.tnear;
-    rr.dir_x = r.direction.x, rr.dir_y = r.direction.y, rr.dir_z = r.direction.z, rr.tfar = r.tfar;
-    rr.mask = 0xffffffffu;
-    rtcOccluded1(scene_, &ctx, &rr);
-    return rr.tfar < 0.0f;
-  }
-  hit intersect(const ray&) const { return {}; }  // not needed here
-
- private:
-  RTCDevice device_;
-  RTCScene scene_;
-};
 
 // Spherical texcoords per corner (u unwrapped per triangle), so the stretch channel has work.
 void add_spherical_texcoords(indexed_mesh& m) {
@@ -87,7 +46,8 @@ void add_spherical_texcoords(indexed_mesh& m) {
 struct elephant_scene {
   indexed_mesh mesh;
   mesh_topology topo;
-  std::unique_ptr<bench_embree_tracer> tracer;
+  std::unique_ptr<support::embree_device> device;
+  std::unique_ptr<support::embree_scene> tracer;
   prepared_visibility_channel visibility;
   bool ok = false;
 };
@@ -102,7 +62,9 @@ elephant_scene& elephant() {
     e.mesh = std::move(*m);
     add_spherical_texcoords(e.mesh);
     e.topo = std::move(*build_topology(e.mesh));
-    e.tracer = std::make_unique<bench_embree_tracer>(e.mesh);
+    e.device = std::make_unique<support::embree_device>("threads=1");
+    e.tracer = std::make_unique<support::embree_scene>(*e.device);
+    if (!e.tracer->add_mesh(e.mesh) || !e.tracer->commit()) return e;
     serial_executor exec;
     e.visibility = std::move(*elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec));
     e.ok = true;

@@ -8,12 +8,14 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <string>
 #include <tuple>
 #include <vector>
 #include <glm/gtc/matrix_transform.hpp>
 #include "brute_tracer.hpp"
 #include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
@@ -302,19 +304,28 @@ TEST_CASE("keyframes: clusters of later keyframes refine earlier ones", "[cluste
   }
 }
 
-TEST_CASE("real meshes: coverage, connectivity, sharp features", "[cluster][real]") {
+TEST_CASE("real meshes through Embree: three channels, coverage, connectivity, determinism", "[cluster][real]") {
+  support::embree_device device;
   for (const char* name : {"bunny00", "armadillo", "fandisk"}) {
     auto m = support::load_mesh(support::cgal_mesh(name));
     REQUIRE(m.ok());
-    const test::brute_tracer tracer(*m);
-    auto r = cluster_mesh(*m, tracer, support::thread_pool_executor{2}, orientation_channel{.threshold = 0.02},
-                          stretch_channel{});
+    support::embree_scene scene(device);
+    REQUIRE(scene.add_mesh(*m).ok());
+    REQUIRE(scene.commit().ok());
     INFO(name);
+    auto run = [&](auto&& exec) {
+      return cluster_mesh(*m, scene, exec, visibility_channel{.threshold = 0.48, .viewpoints = 16, .samples_per_side = 1},
+                          orientation_channel{.threshold = 0.05, .bins = 256}, stretch_channel{});
+    };
+    auto r = run(support::thread_pool_executor{2});
     REQUIRE(r.ok());
     check_invariants(*m, *r);
-    REQUIRE(r->channels[1].skipped != nullptr);
-    REQUIRE(r->cluster_count > 1);
-    REQUIRE(r->cluster_count < m->triangles.size() / 10);
+    REQUIRE(r->channels[0].skipped == nullptr);
+    REQUIRE(r->channels[2].skipped != nullptr);  // no texcoords
+    REQUIRE(r->channels[0].clusters_after > 1);
+    REQUIRE(r->cluster_count >= r->channels[0].clusters_after);
+    REQUIRE(r->cluster_count < m->triangles.size() / 4);
+    if (std::string(name) == "fandisk") REQUIRE(run(serial)->cluster_of == r->cluster_of);
   }
 }
 

@@ -27,6 +27,7 @@
 #include <utility>
 #include <vector>
 #include "infolerp/core/status.hpp"
+#include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 
 namespace infolerp {
@@ -80,21 +81,6 @@ inline status check_threshold(double threshold, const char* what) {
 // exactly 1 for disjoint rows, and the paper wants Th = 1 to give one cluster).
 inline bool is_similar(double js, double threshold) noexcept { return threshold >= 1.0 || js < threshold; }
 
-// I(x;Y) = Σ_y p(y|x) log2(p(y|x)/p(y)) in bits: the part of the mutual information carried by
-// one element (the paper's seed criterion, §3.2.2). Entries with p(y|x) = 0 contribute 0; an
-// entry with p(y|x) > 0 = p(y) cannot happen for a consistent channel and is skipped.
-// Preconditions: row.size() == output.size(). O(n), no allocation.
-// (Local until info/entropy.hpp offers the same function; then this forwards to it.)
-template <class T>
-double element_mutual_information(std::span<const T> row, std::span<const double> output) noexcept {
-  double sum = 0.0;
-  for (std::size_t y = 0; y < row.size(); ++y) {
-    const double p = static_cast<double>(row[y]);
-    if (p > 0.0 && output[y] > 0.0) sum += p * std::log2(p / output[y]);
-  }
-  return std::max(sum, 0.0);
-}
-
 // A direct channel (T→T) aggregated over classes. The row of an element of class a over the M
 // elements is constant inside each class c, so it is stored per class as
 //   row_a(c) = mass(a, c) / Σ_c' mass(a, c')      (mass = summed kernel over c's elements)
@@ -145,7 +131,7 @@ class direct_channel_state {
   double mutual_information(std::uint32_t a) const {
     std::vector<double> r(class_count());
     row(a, r);
-    return element_mutual_information<double>(r, output_);
+    return element_mutual_information(r, output_);
   }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {

@@ -32,6 +32,7 @@
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/mesh/topology.hpp"
+#include "infolerp/mesh/validate.hpp"
 
 namespace infolerp {
 
@@ -67,24 +68,6 @@ concept clustering_channel =
     };
 
 namespace detail {
-
-// Validates indices and positions: every vertex a triangle uses must exist and be finite.
-template <class M>
-status check_positions(const M& m) {
-  const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 tri = mesh_triangle(m, t);
-    for (int c = 0; c < 3; ++c) {
-      if (tri[c] >= nv)
-        return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
-                          " out of range (vertex count ", nv, ")");
-      const glm::vec3 p = mesh_position(m, tri[c]);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        return make_error(errc::non_finite, tri[c], "triangle ", t, ": vertex ", tri[c], " has a non-finite position");
-    }
-  }
-  return {};
-}
 
 // Runs one prepared channel over every current cluster (Algorithm 1's inner loop).
 template <class P, class M, class E>
@@ -177,7 +160,9 @@ status check_inputs(const M& m, const cluster_options& o, const C&... channels) 
   };
   (check(channels), ...);
   if (!st.ok()) return st;
-  return check_positions(m);
+  // Indices and finite positions; degenerate triangles and non-manifold edges are accepted
+  // (their rows are defined, see the channels).
+  return validate_mesh(m, {.allow_degenerate = true, .allow_non_manifold = true});
 }
 
 }  // namespace detail

@@ -39,6 +39,7 @@
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
+#include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
@@ -125,7 +126,9 @@ class visibility_state {
   }
   double mutual_information(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
-    return element_mutual_information<float>(row(t), output_);
+    const auto r = row(t);
+    std::vector<double> d(r.begin(), r.end());
+    return element_mutual_information(d, output_);
   }
 
  private:
