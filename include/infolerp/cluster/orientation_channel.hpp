@@ -12,8 +12,11 @@
 // exact; two approximations remain: (1) every triangle of a cell uses the cell's mean normal as
 // its own (angular error up to about half a cell diagonal, ≈ 2.5/√K rad before the octahedral
 // map's up-to-2× area distortion), and (2) the entries inside a cell are taken as equal, which
-// can only lower JS (data-processing inequality). Measured JS errors and clustering agreement
-// for K ∈ {64, 256, 1024, 4096}: benchmarks/bench_clustering.cpp (BM_OrientationChannel).
+// can only lower JS (data-processing inequality). Measured (BM_OrientationChannel, jittered
+// 2304-triangle torus, sampled pairs): mean |ΔJS| 0.021 / 0.011 / 0.0030 / 0.0012 and max
+// 0.10 / 0.042 / 0.023 / 0.0079 for K = 64 / 256 / 1024 / 4096. Rows near a triangle's own
+// normal are small (1 − n·n' ≈ 0), so relative errors there are large; the greedy threshold
+// clustering amplifies them (adjusted Rand index against exact only 0.35–0.63 at Th = 0.02).
 // Degenerate cases: a planar set is one class (all alike: one cluster, no work); a zero-area
 // triangle's normal is (0,0,0) (mesh/geometry.hpp), its own class with a uniform row.
 #include <algorithm>

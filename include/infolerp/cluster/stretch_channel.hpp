@@ -17,7 +17,11 @@
 // Binned error: a cell's mass Σ(1 − |s_a − s|) is exact for every other cell (the kernel is
 // linear in s away from s_a); the triangle's own value is replaced by its cell's mean (error <=
 // 1/K), the own cell's mass is over-estimated by at most count/K, and entries inside a cell are
-// taken as equal (which can only lower JS). Measured: BM_StretchChannel.
+// taken as equal (which can only lower JS). Measured (BM_StretchChannel, 64×32 UV sphere):
+// mean |ΔJS| 8.5e-4 / 8.3e-5 / 4.4e-5 / 4.4e-5, max 7.9e-3 / 1.3e-3 / 3.7e-4 / 3.7e-4 for
+// K = 64 / 256 / 1024 / 4096. Near S = 1 the row entries 1 − |ΔS| of the least stretched
+// triangles are tiny, so a 1/K shift of the own value changes them by large factors; the
+// clustering at Th = 0.005 then differs from exact (adjusted Rand index 0.66).
 // Meshes without texcoords: prepare() succeeds and skip_reason() says the channel is skipped.
 #include <algorithm>
 #include <cmath>
