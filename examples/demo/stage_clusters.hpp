@@ -2,7 +2,8 @@
 // Demo stage: feature-based clustering of every scene object (clustering paper §3, Algorithm 1:
 // visibility → orientation → stretch), with a progress bar for the visibility rays, written as
 // DIR/clusters.png (the scene from the camera, each cluster a distinct colour).
-//   bool stage_clusters(const demo_context& ctx);   // call after stage_reference
+//   bool stage_clusters(const demo_context& ctx, support::scene_clustering& out);
+// out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage.
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -12,6 +13,7 @@
 #include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/mesh/adaptors.hpp"
+#include "support/demo_upsample.hpp"
 #include "support/procedural.hpp"
 
 namespace infolerp::demo {
@@ -38,10 +40,11 @@ result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& t
                       orientation_channel{.threshold = 0.05, .bins = 256}, stretch_channel{.threshold = 0.1, .bins = 256});
 }
 
-inline bool stage_clusters(const demo_context& ctx) {
-  std::vector<std::vector<std::uint32_t>> ids;  // per object, per triangle: a scene-wide cluster id
+inline bool stage_clusters(const demo_context& ctx, support::scene_clustering& out) {
+  out = {"feature", {}, {}};
   std::uint32_t offset = 0;
-  for (const auto& object : ctx.scene.objects) {
+  for (std::uint32_t g = 0; g < ctx.scene.objects.size(); ++g) {
+    const auto& object = ctx.scene.objects[g];
     std::vector<std::uint32_t> remap;
     const indexed_mesh welded = support::weld_positions(object.mesh, remap);  // seams joined; same triangles
 #ifdef _OPENMP
@@ -59,10 +62,11 @@ inline bool stage_clusters(const demo_context& ctx) {
     std::printf(" after each channel)%s\n", r->channels[2].skipped ? ", stretch skipped: no texcoords" : "");
     for (auto& k : r->cluster_of) k += offset;
     offset += r->cluster_count;
-    ids.push_back(std::move(r->cluster_of));
+    out.ids.push_back(std::move(r->cluster_of));
+    out.geometry_of.insert(out.geometry_of.end(), r->cluster_count, g);
   }
   const auto img = render_false_colour(
-      ctx, [&](std::uint32_t g, std::uint32_t t, glm::vec2) { return cluster_colour(ids[g][t]); });
+      ctx, [&](std::uint32_t g, std::uint32_t t, glm::vec2) { return cluster_colour(out.ids[g][t]); });
   return save_png(ctx, img, "clusters.png");
 }
 
