@@ -33,30 +33,13 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
 
 namespace infolerp {
-
-// splitmix64 (Steele, Lea, Flood 2014): the same sequence on every platform and library,
-// unlike std:: distributions. uniform(n) is unbiased (rejection).
-struct splitmix64 {
-  std::uint64_t state = 0;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
-  // Uniform integer in [0, n). Precondition: n > 0.
-  std::uint64_t uniform(std::uint64_t n) {
-    const std::uint64_t threshold = (0 - n) % n;  // 2^64 mod n
-    for (;;)
-      if (const std::uint64_t x = next(); x >= threshold) return x % n;
-  }
-};
 
 struct salient_clustering_options {
   std::uint32_t clusters = 10;    // C, the number of seeded clusters
