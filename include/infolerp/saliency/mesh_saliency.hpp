@@ -452,87 +452,126 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   return avg;
 }
 
-// Approximate averages: per σ, representatives of cells σ/cells_per_sigma wide, gathered per
-// vertex over the representatives within 2σ. Parallel over vertices; deterministic.
+// Approximate average for one σ by splat–gather–slice on a sparse lattice of spacing h:
+// every point spreads (1, C) to the 8 nodes of its lattice cell with trilinear weights; every
+// node gathers the Gaussian exp(−d²/2σ_n²) of the nodes within 2σ (lattice offsets, so the
+// weights are a table by integer d²); every point reads back Σ t·num / Σ t·den at its 8 nodes.
+// σ_n² = σ² − h²/3 removes the variance the two trilinear steps add (h²/6 each per axis).
+// Only nodes of occupied cells exist (sorted 63-bit keys). Writes avg[k] for point k of g.
+// Parallel over nodes and points; serial splat; deterministic.
+template <class E>
+void grid_gaussian_average(E& exec, const point_grid& g, double sigma, double h, std::size_t grain, double* avg) {
+  const std::size_t P = g.x.size();
+  auto key_of = [](std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return (ix << 42) | (iy << 21) | iz; };
+  constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
+  constexpr auto mask_i = static_cast<std::int64_t>(mask);
+  // Lattice coordinates start one cell below the points' box so that offsets never underflow.
+  const glm::dvec3 lo = g.lo - glm::dvec3(h);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
+  std::vector<double> fx(P), fy(P), fz(P);
+  for (std::size_t k = 0; k < P; ++k) {
+    const double qx = (g.x[k] - lo.x) / h, qy = (g.y[k] - lo.y) / h, qz = (g.z[k] - lo.z) / h;
+    const double bx = std::floor(qx), by = std::floor(qy), bz = std::floor(qz);
+    fx[k] = qx - bx, fy[k] = qy - by, fz[k] = qz - bz;
+    keyed[k] = {key_of(static_cast<std::uint64_t>(bx), static_cast<std::uint64_t>(by), static_cast<std::uint64_t>(bz)),
+                static_cast<std::uint32_t>(k)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  // Occupied cells and their 8 corner nodes.
+  std::vector<std::uint64_t> cells;
+  std::vector<std::uint32_t> cell_of(P);
+  for (std::size_t i = 0; i < P; ++i) {
+    if (cells.empty() || cells.back() != keyed[i].first) cells.push_back(keyed[i].first);
+    cell_of[keyed[i].second] = static_cast<std::uint32_t>(cells.size() - 1);
+  }
+  auto corner = [&](std::uint64_t key, unsigned c) {
+    return key + ((c & 4u) ? std::uint64_t{1} << 42 : 0) + ((c & 2u) ? std::uint64_t{1} << 21 : 0) + (c & 1u);
+  };
+  std::vector<std::uint64_t> nodes;
+  nodes.reserve(cells.size() * 4);
+  for (std::uint64_t c : cells)
+    for (unsigned q = 0; q < 8; ++q) nodes.push_back(corner(c, q));
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  const std::size_t N = nodes.size();
+  std::vector<std::uint32_t> cell_nodes(cells.size() * 8);
+  exec.parallel_for(cells.size(), 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c)
+      for (unsigned q = 0; q < 8; ++q)
+        cell_nodes[c * 8 + q] = static_cast<std::uint32_t>(
+            std::lower_bound(nodes.begin(), nodes.end(), corner(cells[c], q)) - nodes.begin());
+  });
+  auto trilinear = [&](std::size_t k, double* t) {
+    const double x = fx[k], y = fy[k], z = fz[k];
+    for (unsigned q = 0; q < 8; ++q)
+      t[q] = ((q & 4u) ? x : 1.0 - x) * ((q & 2u) ? y : 1.0 - y) * ((q & 1u) ? z : 1.0 - z);
+  };
+  // Splat (serial, points in a fixed order).
+  std::vector<double> sn(N, 0.0), sd(N, 0.0);
+  for (std::size_t k = 0; k < P; ++k) {
+    double t[8];
+    trilinear(k, t);
+    const std::uint32_t* cn = &cell_nodes[std::size_t{cell_of[k]} * 8];
+    for (unsigned q = 0; q < 8; ++q) sn[cn[q]] += t[q] * g.value[k], sd[cn[q]] += t[q];
+  }
+  // Gather: node-to-node Gaussian within the lattice ball of radius 2σ/h.
+  const double R = 2.0 * sigma / h;
+  const auto r = static_cast<std::int64_t>(std::floor(R));
+  const double sn2 = std::max(sigma * sigma - h * h / 3.0, 0.25 * sigma * sigma);
+  std::vector<double> table(static_cast<std::size_t>(R * R) + 1);
+  for (std::size_t d2 = 0; d2 < table.size(); ++d2) table[d2] = std::exp(-static_cast<double>(d2) * h * h / (2.0 * sn2));
+  std::vector<double> bn(N), bd(N);
+  exec.parallel_for(N, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+    for (std::size_t n = b; n < e; ++n) {
+      const auto ix = static_cast<std::int64_t>(nodes[n] >> 42), iy = static_cast<std::int64_t>((nodes[n] >> 21) & mask);
+      const auto iz = static_cast<std::int64_t>(nodes[n] & mask);
+      double num = 0.0, den = 0.0;
+      for (std::int64_t dx = -r; dx <= r; ++dx)
+        for (std::int64_t dy = -r; dy <= r; ++dy) {
+          const std::int64_t dxy = dx * dx + dy * dy;
+          if (static_cast<double>(dxy) > R * R || ix + dx < 0 || iy + dy < 0 || ix + dx > mask_i || iy + dy > mask_i)
+            continue;
+          const auto rz = static_cast<std::int64_t>(std::floor(std::sqrt(R * R - static_cast<double>(dxy))));
+          const auto cx = static_cast<std::uint64_t>(ix + dx), cy = static_cast<std::uint64_t>(iy + dy);
+          const std::uint64_t first = key_of(cx, cy, static_cast<std::uint64_t>(std::max<std::int64_t>(iz - rz, 0)));
+          const std::uint64_t last = key_of(cx, cy, static_cast<std::uint64_t>(std::min(iz + rz, mask_i)));
+          for (auto it = std::lower_bound(nodes.begin(), nodes.end(), first); it != nodes.end() && *it <= last; ++it) {
+            const std::size_t j = static_cast<std::size_t>(it - nodes.begin());
+            const auto dz = static_cast<std::int64_t>(*it & mask) - iz;
+            const double w = table[static_cast<std::size_t>(dxy + dz * dz)];
+            num += w * sn[j], den += w * sd[j];
+          }
+        }
+      bn[n] = num, bd[n] = den;
+    }
+  });
+  // Slice.
+  exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      double t[8];
+      trilinear(k, t);
+      const std::uint32_t* cn = &cell_nodes[std::size_t{cell_of[k]} * 8];
+      double num = 0.0, den = 0.0;
+      for (unsigned q = 0; q < 8; ++q) num += t[q] * bn[cn[q]], den += t[q] * bd[cn[q]];
+      avg[k] = den > 0.0 ? num / den : g.value[k];
+    }
+  });
+}
+
+// Approximate averages for every σ (see grid_gaussian_average), lattice spacing
+// σ / cells_per_sigma. Returns avg[u * P + k] for point k of g.
 template <class E>
 std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, const std::vector<double>& sigma,
                                                   double cells_per_sigma, std::size_t grain) {
   const std::size_t P = g.x.size(), L = sigma.size();
   std::vector<double> avg(L * P);
-  std::vector<glm::dvec3> rep_pos;
-  std::vector<double> rep_sum, rep_count, rep_spread;
-  std::vector<std::uint32_t> rep_ids;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  double extent = 0.0;
+  for (std::size_t k = 0; k < P; ++k)
+    extent = std::max({extent, g.x[k] - g.lo.x, g.y[k] - g.lo.y, g.z[k] - g.lo.z});
   for (std::size_t u = 0; u < L; ++u) {
-    // Representatives: bin the points into cells of size h (sparse: sort by 63-bit cell key).
-    const double h = sigma[u] / cells_per_sigma;
-    keyed.resize(P);
-    for (std::size_t k = 0; k < P; ++k) {
-      auto q = [&](double p, int axis) {
-        return static_cast<std::uint64_t>(std::min(std::floor((p - g.lo[axis]) / h), 2097151.0));
-      };
-      keyed[k] = {(q(g.x[k], 0) << 42) | (q(g.y[k], 1) << 21) | q(g.z[k], 2), static_cast<std::uint32_t>(k)};
-    }
-    std::sort(keyed.begin(), keyed.end());
-    rep_pos.clear(), rep_sum.clear(), rep_count.clear(), rep_ids.clear(), rep_spread.clear();
-    for (std::size_t b = 0; b < P;) {
-      std::size_t e = b;
-      glm::dvec3 s(0.0);
-      double cs = 0.0;
-      for (; e < P && keyed[e].first == keyed[b].first; ++e) {
-        const std::uint32_t k = keyed[e].second;
-        s += glm::dvec3(g.x[k], g.y[k], g.z[k]), cs += g.value[k];
-      }
-      const double cnt = static_cast<double>(e - b);
-      const glm::dvec3 centre = s / cnt;
-      double spread = 0.0;  // RMS distance of the cell's points to their centroid
-      for (std::size_t f = b; f < e; ++f) {
-        const std::uint32_t k = keyed[f].second;
-        const glm::dvec3 d = glm::dvec3(g.x[k], g.y[k], g.z[k]) - centre;
-        spread += glm::dot(d, d);
-      }
-      rep_pos.push_back(centre), rep_sum.push_back(cs), rep_count.push_back(cnt);
-      rep_spread.push_back(std::sqrt(spread / cnt));
-      rep_ids.push_back(static_cast<std::uint32_t>(rep_ids.size()));
-      b = e;
-    }
-    const point_grid reps = make_point_grid(rep_pos, rep_sum, rep_count, rep_ids, 2.0 * sigma[u] + 1.5 * h);
-    const double r2 = 4.0 * sigma[u] * sigma[u], a = 1.0 / (2.0 * sigma[u] * sigma[u]);
-    const double inner = std::max(0.0, 2.0 * sigma[u] - 1.5 * h), outer = 2.0 * sigma[u] + 1.5 * h;
-    const std::vector<double>& reps_spread = rep_spread;
-    const double inner2 = inner * inner, outer2 = outer * outer;
-    exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const double xi = g.x[k], yi = g.y[k], zi = g.z[k];
-        const std::uint32_t cx = reps.coord(xi, 0), cy = reps.coord(yi, 1), cz = reps.coord(zi, 2);
-        double num = 0.0, den = 0.0;
-        for (std::uint32_t ax = cx > 0 ? cx - 1 : 0; ax <= std::min(cx + 1, reps.n[0] - 1); ++ax)
-          for (std::uint32_t ay = cy > 0 ? cy - 1 : 0; ay <= std::min(cy + 1, reps.n[1] - 1); ++ay)
-            for (std::uint32_t az = cz > 0 ? cz - 1 : 0; az <= std::min(cz + 1, reps.n[2] - 1); ++az) {
-              const std::uint32_t c = reps.cell_index(ax, ay, az);
-              for (std::uint32_t j = reps.cell_start[c]; j < reps.cell_start[c + 1]; ++j) {
-                const double dx = reps.x[j] - xi, dy = reps.y[j] - yi, dz = reps.z[j] - zi;
-                const double d2 = dx * dx + dy * dy + dz * dz;
-                if (d2 > outer2) continue;
-                // Soft cutoff: a cell straddling the ball's edge counts with roughly the
-                // fraction of its points inside (a linear ramp of half-width 1.5 × its RMS
-                // spread around 2σ; a single point keeps the hard cutoff).
-                double w = exp_neg2(-std::min(d2, r2) * a);
-                if (d2 > inner2) {
-                  const double ramp = 1.5 * reps_spread[reps.id[j]];
-                  const double dist = std::sqrt(d2);
-                  if (ramp > 0.0)
-                    w *= std::clamp(0.5 + (2.0 * sigma[u] - dist) / (2.0 * ramp), 0.0, 1.0);
-                  else if (d2 > r2)
-                    continue;
-                }
-                num += w * reps.value[j];
-                den += w * reps.weight[j];
-              }
-            }
-        avg[u * P + k] = den > 0.0 ? num / den : g.value[k];
-      }
-    });
+    // Lattice coordinates must fit 21 bits (with a margin for the corner and the ball).
+    const double h = std::max(sigma[u] / cells_per_sigma, extent / 1.0e6);
+    grid_gaussian_average(exec, g, sigma[u], h, grain, avg.data() + u * P);
   }
   return avg;
 }
