@@ -195,6 +195,20 @@ struct column_grid {
   std::vector<std::uint32_t> col_of;      // column of each sorted point
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
   std::uint32_t nx = 1, ny = 1;
+  // Column coordinates of any position (clamped to the grid).
+  std::uint32_t column_x(double px) const {
+    return std::min(static_cast<std::uint32_t>(std::max(px - x0, 0.0) / h), nx - 1);
+  }
+  std::uint32_t column_y(double py) const {
+    return std::min(static_cast<std::uint32_t>(std::max(py - y0, 0.0) / h), ny - 1);
+  }
+};
+
+// Query positions for gather_points: result of query i goes to slot out[i] (count slots).
+struct query_points {
+  const double *x, *y, *z;
+  const std::uint32_t* out;
+  std::size_t count;
 };
 
 // Builds a column_grid with columns about `width` wide (wider when needed to keep the column
@@ -324,15 +338,15 @@ INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
 // first ball that holds none of the 4. Each lane accumulates its own partial sums, which are
 // added in a fixed order at the end: the result depends on the data only.
 template <class V>
-INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
-                          std::size_t last, double* avg) {
+INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const query_points& qp, const sigma_table& t,
+                                             std::uint32_t span, std::size_t first, std::size_t last, double* avg) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
-  const std::size_t L = t.r2.size(), P = g.x.size();
+  const std::size_t L = t.r2.size(), P = qp.count;
   const double r2max = t.r2[L - 1];
   for (std::size_t i = first; i < last; ++i) {
-    const double xi = g.x[i], yi = g.y[i], zi = g.z[i];
+    const double xi = qp.x[i], yi = qp.y[i], zi = qp.z[i];
     V acc_n[32][G] = {}, acc_d[32][G] = {}, w[32][G];
-    const std::uint32_t cx = g.col_of[i] / g.ny, cy = g.col_of[i] % g.ny;
+    const std::uint32_t cx = g.column_x(xi), cy = g.column_y(yi);
     const std::uint32_t ax0 = cx > span ? cx - span : 0, ax1 = std::min(cx + span, g.nx - 1);
     const std::uint32_t ay0 = cy > span ? cy - span : 0, ay1 = std::min(cy + span, g.ny - 1);
     for (std::uint32_t ax = ax0; ax <= ax1; ++ax)
@@ -399,27 +413,27 @@ INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_ta
       std::memcpy(d, acc_d[u], sizeof d);
       for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
         for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
-      avg[u * P + g.src[i]] = n[0] / d[0];
+      avg[u * P + qp.out[i]] = n[0] / d[0];
     }
   }
 }
 
-inline void gather_points_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
-                                   std::size_t last, double* avg) {
+inline void gather_points_portable(const column_grid& g, const query_points& q, const sigma_table& t,
+                                   std::uint32_t span, std::size_t first, std::size_t last, double* avg) {
 #if defined(__GNUC__) || defined(__clang__)
-  gather_points<v2d>(g, t, span, first, last, avg);
+  gather_points<v2d>(g, q, t, span, first, last, avg);
 #else
-  gather_points<lanes_fallback>(g, t, span, first, last, avg);
+  gather_points<lanes_fallback>(g, q, t, span, first, last, avg);
 #endif
 }
 
 // Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel.
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
 #define INFOLERP_SALIENCY_AVX2 1
-__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const sigma_table& t,
-                                                                   std::uint32_t span, std::size_t first,
-                                                                   std::size_t last, double* avg) {
-  gather_points<v4d>(g, t, span, first, last, avg);
+__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const query_points& q,
+                                                                   const sigma_table& t, std::uint32_t span,
+                                                                   std::size_t first, std::size_t last, double* avg) {
+  gather_points<v4d>(g, q, t, span, first, last, avg);
 }
 inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 #endif
@@ -431,23 +445,25 @@ inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __buil
 // points. Returns avg[u * P + k] for point k of g. Each point gathers its own sums (every pair
 // is evaluated from both ends), so points are independent: parallel with no write conflicts,
 // identical bits for any executor and thread count.
+// With `queries` the averages are taken at those positions instead (avg[u * count + out[i]]).
 template <class E>
 std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const std::vector<double>& sigma,
-                                            std::size_t grain) {
-  const std::size_t P = pg.x.size(), L = sigma.size();
+                                            std::size_t grain, const query_points* queries = nullptr) {
+  const std::size_t L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
   const column_grid g = make_column_grid(pg, rmax / 3.0);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
-  std::vector<double> avg(L * P);
+  const query_points q = queries ? *queries : query_points{g.x.data(), g.y.data(), g.z.data(), g.src.data(), g.x.size()};
+  std::vector<double> avg(L * q.count);
 #ifdef INFOLERP_SALIENCY_AVX2
   const bool avx2 = cpu_has_avx2_fma();
 #endif
-  exec.parallel_for(P, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+  exec.parallel_for(q.count, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
 #ifdef INFOLERP_SALIENCY_AVX2
-    if (avx2) return gather_points_avx2(g, t, span, b, e, avg.data());
+    if (avx2) return gather_points_avx2(g, q, t, span, b, e, avg.data());
 #endif
-    gather_points_portable(g, t, span, b, e, avg.data());
+    gather_points_portable(g, q, t, span, b, e, avg.data());
   });
   return avg;
 }
@@ -464,7 +480,6 @@ void grid_gaussian_average(E& exec, const point_grid& g, double sigma, double h,
   const std::size_t P = g.x.size();
   auto key_of = [](std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return (ix << 42) | (iy << 21) | iz; };
   constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
-  constexpr auto mask_i = static_cast<std::int64_t>(mask);
   // Lattice coordinates start one cell below the points' box so that offsets never underflow.
   const glm::dvec3 lo = g.lo - glm::dvec3(h);
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
@@ -506,54 +521,26 @@ void grid_gaussian_average(E& exec, const point_grid& g, double sigma, double h,
     for (unsigned q = 0; q < 8; ++q)
       t[q] = ((q & 4u) ? x : 1.0 - x) * ((q & 2u) ? y : 1.0 - y) * ((q & 1u) ? z : 1.0 - z);
   };
-  // Splat (serial, points in a fixed order).
-  std::vector<double> sn(N, 0.0), sd(N, 0.0);
-  for (std::size_t k = 0; k < P; ++k) {
-    double t[8];
-    trilinear(k, t);
-    const std::uint32_t* cn = &cell_nodes[std::size_t{cell_of[k]} * 8];
-    for (unsigned q = 0; q < 8; ++q) sn[cn[q]] += t[q] * g.value[k], sd[cn[q]] += t[q];
+  // Exact ball averages at the nodes.
+  std::vector<double> qx(N), qy(N), qz(N);
+  std::vector<std::uint32_t> out(N);
+  for (std::size_t n = 0; n < N; ++n) {
+    qx[n] = lo.x + h * static_cast<double>(nodes[n] >> 42);
+    qy[n] = lo.y + h * static_cast<double>((nodes[n] >> 21) & mask);
+    qz[n] = lo.z + h * static_cast<double>(nodes[n] & mask);
+    out[n] = static_cast<std::uint32_t>(n);
   }
-  // Gather: node-to-node Gaussian within the lattice ball of radius 2σ/h.
-  const double R = 2.0 * sigma / h;
-  const auto r = static_cast<std::int64_t>(std::floor(R));
-  const double sn2 = std::max(sigma * sigma - h * h / 3.0, 0.25 * sigma * sigma);
-  std::vector<double> table(static_cast<std::size_t>(R * R) + 1);
-  for (std::size_t d2 = 0; d2 < table.size(); ++d2) table[d2] = std::exp(-static_cast<double>(d2) * h * h / (2.0 * sn2));
-  std::vector<double> bn(N), bd(N);
-  exec.parallel_for(N, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-    for (std::size_t n = b; n < e; ++n) {
-      const auto ix = static_cast<std::int64_t>(nodes[n] >> 42), iy = static_cast<std::int64_t>((nodes[n] >> 21) & mask);
-      const auto iz = static_cast<std::int64_t>(nodes[n] & mask);
-      double num = 0.0, den = 0.0;
-      for (std::int64_t dx = -r; dx <= r; ++dx)
-        for (std::int64_t dy = -r; dy <= r; ++dy) {
-          const std::int64_t dxy = dx * dx + dy * dy;
-          if (static_cast<double>(dxy) > R * R || ix + dx < 0 || iy + dy < 0 || ix + dx > mask_i || iy + dy > mask_i)
-            continue;
-          const auto rz = static_cast<std::int64_t>(std::floor(std::sqrt(R * R - static_cast<double>(dxy))));
-          const auto cx = static_cast<std::uint64_t>(ix + dx), cy = static_cast<std::uint64_t>(iy + dy);
-          const std::uint64_t first = key_of(cx, cy, static_cast<std::uint64_t>(std::max<std::int64_t>(iz - rz, 0)));
-          const std::uint64_t last = key_of(cx, cy, static_cast<std::uint64_t>(std::min(iz + rz, mask_i)));
-          for (auto it = std::lower_bound(nodes.begin(), nodes.end(), first); it != nodes.end() && *it <= last; ++it) {
-            const std::size_t j = static_cast<std::size_t>(it - nodes.begin());
-            const auto dz = static_cast<std::int64_t>(*it & mask) - iz;
-            const double w = table[static_cast<std::size_t>(dxy + dz * dz)];
-            num += w * sn[j], den += w * sd[j];
-          }
-        }
-      bn[n] = num, bd[n] = den;
-    }
-  });
+  const query_points q{qx.data(), qy.data(), qz.data(), out.data(), N};
+  const std::vector<double> at_node = exact_gaussian_averages(exec, g, {sigma}, grain, &q);
   // Slice.
   exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       double t[8];
       trilinear(k, t);
       const std::uint32_t* cn = &cell_nodes[std::size_t{cell_of[k]} * 8];
-      double num = 0.0, den = 0.0;
-      for (unsigned q = 0; q < 8; ++q) num += t[q] * bn[cn[q]], den += t[q] * bd[cn[q]];
-      avg[k] = den > 0.0 ? num / den : g.value[k];
+      double sum = 0.0;
+      for (unsigned c = 0; c < 8; ++c) sum += t[c] * at_node[cn[c]];
+      avg[k] = sum;
     }
   });
 }
@@ -597,9 +584,9 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
-  if (opt.method == saliency_method::approximate && !(opt.approx_cells_per_sigma >= 0.5))
+  if (opt.method == saliency_method::approximate && !(opt.approx_cells_per_sigma >= 1.0))
     return make_error(errc::bad_parameter, no_element, "approx_cells_per_sigma ", opt.approx_cells_per_sigma,
-                      " must be at least 0.5");
+                      " must be at least 1");
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
