@@ -53,6 +53,18 @@
 // subdivided once 7.9% at 2, 6.2% at 3, 3.7% at 4, where Lee's local-maxima normalisation
 // amplifies small level errors. On that mesh this mode is no faster than exact (5.5, 8.9 and
 // 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes.
+// Lattice schemes tried instead (branch salapprox, issue 4) and not kept, because they fail the
+// 1% test on the bumpy sphere (lattice spacing h = σ / cells per σ, refined_elephant subdivided
+// once, error = relative L2 of the final saliency against exact, CPU time of the whole call):
+//   - splat–gather–slice: trilinear splat of (1, C), node-to-node ball-truncated Gaussian
+//     (σ_n² = σ² − h²/3), trilinear slice: 11.4% at 1 cell per σ (0.42 s CPU), 9.0% at 2
+//     (1.1 s), 8.8% at 4 (7.4 s), 7.2% at 6 (32 s); bumpy sphere 4.2% at 4.
+//   - exact ball averages at the lattice nodes, trilinear slice: 10.8% at 1 (0.63 s CPU), 9.0%
+//     at 2 (1.5 s), 8.3% at 3 (2.6 s), 7.5% at 4 (4.0 s), 6.4% at 5 (5.2 s), 5.1% at 6 (6.1 s,
+//     as slow as exact); bumpy sphere 8.8% at 4.
+// Both converge slowly because S_i = |G(σ) − G(2σ)| is a small difference of two averages
+// (worst level errors 14–33% on the bumpy sphere), and the hard 2σ cutoff (a step of e⁻² in the
+// kernel) is smeared by any lattice: its error is first order in h/σ.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -195,20 +207,6 @@ struct column_grid {
   std::vector<std::uint32_t> col_of;      // column of each sorted point
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
   std::uint32_t nx = 1, ny = 1;
-  // Column coordinates of any position (clamped to the grid).
-  std::uint32_t column_x(double px) const {
-    return std::min(static_cast<std::uint32_t>(std::max(px - x0, 0.0) / h), nx - 1);
-  }
-  std::uint32_t column_y(double py) const {
-    return std::min(static_cast<std::uint32_t>(std::max(py - y0, 0.0) / h), ny - 1);
-  }
-};
-
-// Query positions for gather_points: result of query i goes to slot out[i] (count slots).
-struct query_points {
-  const double *x, *y, *z;
-  const std::uint32_t* out;
-  std::size_t count;
 };
 
 // Builds a column_grid with columns about `width` wide (wider when needed to keep the column
@@ -338,15 +336,15 @@ INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
 // first ball that holds none of the 4. Each lane accumulates its own partial sums, which are
 // added in a fixed order at the end: the result depends on the data only.
 template <class V>
-INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const query_points& qp, const sigma_table& t,
-                                             std::uint32_t span, std::size_t first, std::size_t last, double* avg) {
+INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
+                          std::size_t last, double* avg) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
-  const std::size_t L = t.r2.size(), P = qp.count;
+  const std::size_t L = t.r2.size(), P = g.x.size();
   const double r2max = t.r2[L - 1];
   for (std::size_t i = first; i < last; ++i) {
-    const double xi = qp.x[i], yi = qp.y[i], zi = qp.z[i];
+    const double xi = g.x[i], yi = g.y[i], zi = g.z[i];
     V acc_n[32][G] = {}, acc_d[32][G] = {}, w[32][G];
-    const std::uint32_t cx = g.column_x(xi), cy = g.column_y(yi);
+    const std::uint32_t cx = g.col_of[i] / g.ny, cy = g.col_of[i] % g.ny;
     const std::uint32_t ax0 = cx > span ? cx - span : 0, ax1 = std::min(cx + span, g.nx - 1);
     const std::uint32_t ay0 = cy > span ? cy - span : 0, ay1 = std::min(cy + span, g.ny - 1);
     for (std::uint32_t ax = ax0; ax <= ax1; ++ax)
@@ -413,27 +411,27 @@ INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const query_po
       std::memcpy(d, acc_d[u], sizeof d);
       for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
         for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
-      avg[u * P + qp.out[i]] = n[0] / d[0];
+      avg[u * P + g.src[i]] = n[0] / d[0];
     }
   }
 }
 
-inline void gather_points_portable(const column_grid& g, const query_points& q, const sigma_table& t,
-                                   std::uint32_t span, std::size_t first, std::size_t last, double* avg) {
+inline void gather_points_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
+                                   std::size_t last, double* avg) {
 #if defined(__GNUC__) || defined(__clang__)
-  gather_points<v2d>(g, q, t, span, first, last, avg);
+  gather_points<v2d>(g, t, span, first, last, avg);
 #else
-  gather_points<lanes_fallback>(g, q, t, span, first, last, avg);
+  gather_points<lanes_fallback>(g, t, span, first, last, avg);
 #endif
 }
 
 // Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel.
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
 #define INFOLERP_SALIENCY_AVX2 1
-__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const query_points& q,
-                                                                   const sigma_table& t, std::uint32_t span,
-                                                                   std::size_t first, std::size_t last, double* avg) {
-  gather_points<v4d>(g, q, t, span, first, last, avg);
+__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const sigma_table& t,
+                                                                   std::uint32_t span, std::size_t first,
+                                                                   std::size_t last, double* avg) {
+  gather_points<v4d>(g, t, span, first, last, avg);
 }
 inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 #endif
@@ -445,120 +443,108 @@ inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __buil
 // points. Returns avg[u * P + k] for point k of g. Each point gathers its own sums (every pair
 // is evaluated from both ends), so points are independent: parallel with no write conflicts,
 // identical bits for any executor and thread count.
-// With `queries` the averages are taken at those positions instead (avg[u * count + out[i]]).
 template <class E>
 std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const std::vector<double>& sigma,
-                                            std::size_t grain, const query_points* queries = nullptr) {
-  const std::size_t L = sigma.size();
+                                            std::size_t grain) {
+  const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
   const column_grid g = make_column_grid(pg, rmax / 3.0);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
-  const query_points q = queries ? *queries : query_points{g.x.data(), g.y.data(), g.z.data(), g.src.data(), g.x.size()};
-  std::vector<double> avg(L * q.count);
+  std::vector<double> avg(L * P);
 #ifdef INFOLERP_SALIENCY_AVX2
   const bool avx2 = cpu_has_avx2_fma();
 #endif
-  exec.parallel_for(q.count, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+  exec.parallel_for(P, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
 #ifdef INFOLERP_SALIENCY_AVX2
-    if (avx2) return gather_points_avx2(g, q, t, span, b, e, avg.data());
+    if (avx2) return gather_points_avx2(g, t, span, b, e, avg.data());
 #endif
-    gather_points_portable(g, q, t, span, b, e, avg.data());
+    gather_points_portable(g, t, span, b, e, avg.data());
   });
   return avg;
 }
 
-// Approximate average for one σ by splat–gather–slice on a sparse lattice of spacing h:
-// every point spreads (1, C) to the 8 nodes of its lattice cell with trilinear weights; every
-// node gathers the Gaussian exp(−d²/2σ_n²) of the nodes within 2σ (lattice offsets, so the
-// weights are a table by integer d²); every point reads back Σ t·num / Σ t·den at its 8 nodes.
-// σ_n² = σ² − h²/3 removes the variance the two trilinear steps add (h²/6 each per axis).
-// Only nodes of occupied cells exist (sorted 63-bit keys). Writes avg[k] for point k of g.
-// Parallel over nodes and points; serial splat; deterministic.
-template <class E>
-void grid_gaussian_average(E& exec, const point_grid& g, double sigma, double h, std::size_t grain, double* avg) {
-  const std::size_t P = g.x.size();
-  auto key_of = [](std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return (ix << 42) | (iy << 21) | iz; };
-  constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
-  // Lattice coordinates start one cell below the points' box so that offsets never underflow.
-  const glm::dvec3 lo = g.lo - glm::dvec3(h);
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
-  std::vector<double> fx(P), fy(P), fz(P);
-  for (std::size_t k = 0; k < P; ++k) {
-    const double qx = (g.x[k] - lo.x) / h, qy = (g.y[k] - lo.y) / h, qz = (g.z[k] - lo.z) / h;
-    const double bx = std::floor(qx), by = std::floor(qy), bz = std::floor(qz);
-    fx[k] = qx - bx, fy[k] = qy - by, fz[k] = qz - bz;
-    keyed[k] = {key_of(static_cast<std::uint64_t>(bx), static_cast<std::uint64_t>(by), static_cast<std::uint64_t>(bz)),
-                static_cast<std::uint32_t>(k)};
-  }
-  std::sort(keyed.begin(), keyed.end());
-  // Occupied cells and their 8 corner nodes.
-  std::vector<std::uint64_t> cells;
-  std::vector<std::uint32_t> cell_of(P);
-  for (std::size_t i = 0; i < P; ++i) {
-    if (cells.empty() || cells.back() != keyed[i].first) cells.push_back(keyed[i].first);
-    cell_of[keyed[i].second] = static_cast<std::uint32_t>(cells.size() - 1);
-  }
-  auto corner = [&](std::uint64_t key, unsigned c) {
-    return key + ((c & 4u) ? std::uint64_t{1} << 42 : 0) + ((c & 2u) ? std::uint64_t{1} << 21 : 0) + (c & 1u);
-  };
-  std::vector<std::uint64_t> nodes;
-  nodes.reserve(cells.size() * 4);
-  for (std::uint64_t c : cells)
-    for (unsigned q = 0; q < 8; ++q) nodes.push_back(corner(c, q));
-  std::sort(nodes.begin(), nodes.end());
-  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-  const std::size_t N = nodes.size();
-  std::vector<std::uint32_t> cell_nodes(cells.size() * 8);
-  exec.parallel_for(cells.size(), 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c)
-      for (unsigned q = 0; q < 8; ++q)
-        cell_nodes[c * 8 + q] = static_cast<std::uint32_t>(
-            std::lower_bound(nodes.begin(), nodes.end(), corner(cells[c], q)) - nodes.begin());
-  });
-  auto trilinear = [&](std::size_t k, double* t) {
-    const double x = fx[k], y = fy[k], z = fz[k];
-    for (unsigned q = 0; q < 8; ++q)
-      t[q] = ((q & 4u) ? x : 1.0 - x) * ((q & 2u) ? y : 1.0 - y) * ((q & 1u) ? z : 1.0 - z);
-  };
-  // Exact ball averages at the nodes.
-  std::vector<double> qx(N), qy(N), qz(N);
-  std::vector<std::uint32_t> out(N);
-  for (std::size_t n = 0; n < N; ++n) {
-    qx[n] = lo.x + h * static_cast<double>(nodes[n] >> 42);
-    qy[n] = lo.y + h * static_cast<double>((nodes[n] >> 21) & mask);
-    qz[n] = lo.z + h * static_cast<double>(nodes[n] & mask);
-    out[n] = static_cast<std::uint32_t>(n);
-  }
-  const query_points q{qx.data(), qy.data(), qz.data(), out.data(), N};
-  const std::vector<double> at_node = exact_gaussian_averages(exec, g, {sigma}, grain, &q);
-  // Slice.
-  exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      double t[8];
-      trilinear(k, t);
-      const std::uint32_t* cn = &cell_nodes[std::size_t{cell_of[k]} * 8];
-      double sum = 0.0;
-      for (unsigned c = 0; c < 8; ++c) sum += t[c] * at_node[cn[c]];
-      avg[k] = sum;
-    }
-  });
-}
-
-// Approximate averages for every σ (see grid_gaussian_average), lattice spacing
-// σ / cells_per_sigma. Returns avg[u * P + k] for point k of g.
+// Approximate averages: per σ, representatives of cells σ/cells_per_sigma wide, gathered per
+// vertex over the representatives within 2σ. Parallel over vertices; deterministic.
 template <class E>
 std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, const std::vector<double>& sigma,
                                                   double cells_per_sigma, std::size_t grain) {
   const std::size_t P = g.x.size(), L = sigma.size();
   std::vector<double> avg(L * P);
-  double extent = 0.0;
-  for (std::size_t k = 0; k < P; ++k)
-    extent = std::max({extent, g.x[k] - g.lo.x, g.y[k] - g.lo.y, g.z[k] - g.lo.z});
+  std::vector<glm::dvec3> rep_pos;
+  std::vector<double> rep_sum, rep_count, rep_spread;
+  std::vector<std::uint32_t> rep_ids;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   for (std::size_t u = 0; u < L; ++u) {
-    // Lattice coordinates must fit 21 bits (with a margin for the corner and the ball).
-    const double h = std::max(sigma[u] / cells_per_sigma, extent / 1.0e6);
-    grid_gaussian_average(exec, g, sigma[u], h, grain, avg.data() + u * P);
+    // Representatives: bin the points into cells of size h (sparse: sort by 63-bit cell key).
+    const double h = sigma[u] / cells_per_sigma;
+    keyed.resize(P);
+    for (std::size_t k = 0; k < P; ++k) {
+      auto q = [&](double p, int axis) {
+        return static_cast<std::uint64_t>(std::min(std::floor((p - g.lo[axis]) / h), 2097151.0));
+      };
+      keyed[k] = {(q(g.x[k], 0) << 42) | (q(g.y[k], 1) << 21) | q(g.z[k], 2), static_cast<std::uint32_t>(k)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    rep_pos.clear(), rep_sum.clear(), rep_count.clear(), rep_ids.clear(), rep_spread.clear();
+    for (std::size_t b = 0; b < P;) {
+      std::size_t e = b;
+      glm::dvec3 s(0.0);
+      double cs = 0.0;
+      for (; e < P && keyed[e].first == keyed[b].first; ++e) {
+        const std::uint32_t k = keyed[e].second;
+        s += glm::dvec3(g.x[k], g.y[k], g.z[k]), cs += g.value[k];
+      }
+      const double cnt = static_cast<double>(e - b);
+      const glm::dvec3 centre = s / cnt;
+      double spread = 0.0;  // RMS distance of the cell's points to their centroid
+      for (std::size_t f = b; f < e; ++f) {
+        const std::uint32_t k = keyed[f].second;
+        const glm::dvec3 d = glm::dvec3(g.x[k], g.y[k], g.z[k]) - centre;
+        spread += glm::dot(d, d);
+      }
+      rep_pos.push_back(centre), rep_sum.push_back(cs), rep_count.push_back(cnt);
+      rep_spread.push_back(std::sqrt(spread / cnt));
+      rep_ids.push_back(static_cast<std::uint32_t>(rep_ids.size()));
+      b = e;
+    }
+    const point_grid reps = make_point_grid(rep_pos, rep_sum, rep_count, rep_ids, 2.0 * sigma[u] + 1.5 * h);
+    const double r2 = 4.0 * sigma[u] * sigma[u], a = 1.0 / (2.0 * sigma[u] * sigma[u]);
+    const double inner = std::max(0.0, 2.0 * sigma[u] - 1.5 * h), outer = 2.0 * sigma[u] + 1.5 * h;
+    const std::vector<double>& reps_spread = rep_spread;
+    const double inner2 = inner * inner, outer2 = outer * outer;
+    exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const double xi = g.x[k], yi = g.y[k], zi = g.z[k];
+        const std::uint32_t cx = reps.coord(xi, 0), cy = reps.coord(yi, 1), cz = reps.coord(zi, 2);
+        double num = 0.0, den = 0.0;
+        for (std::uint32_t ax = cx > 0 ? cx - 1 : 0; ax <= std::min(cx + 1, reps.n[0] - 1); ++ax)
+          for (std::uint32_t ay = cy > 0 ? cy - 1 : 0; ay <= std::min(cy + 1, reps.n[1] - 1); ++ay)
+            for (std::uint32_t az = cz > 0 ? cz - 1 : 0; az <= std::min(cz + 1, reps.n[2] - 1); ++az) {
+              const std::uint32_t c = reps.cell_index(ax, ay, az);
+              for (std::uint32_t j = reps.cell_start[c]; j < reps.cell_start[c + 1]; ++j) {
+                const double dx = reps.x[j] - xi, dy = reps.y[j] - yi, dz = reps.z[j] - zi;
+                const double d2 = dx * dx + dy * dy + dz * dz;
+                if (d2 > outer2) continue;
+                // Soft cutoff: a cell straddling the ball's edge counts with roughly the
+                // fraction of its points inside (a linear ramp of half-width 1.5 × its RMS
+                // spread around 2σ; a single point keeps the hard cutoff).
+                double w = exp_neg2(-std::min(d2, r2) * a);
+                if (d2 > inner2) {
+                  const double ramp = 1.5 * reps_spread[reps.id[j]];
+                  const double dist = std::sqrt(d2);
+                  if (ramp > 0.0)
+                    w *= std::clamp(0.5 + (2.0 * sigma[u] - dist) / (2.0 * ramp), 0.0, 1.0);
+                  else if (d2 > r2)
+                    continue;
+                }
+                num += w * reps.value[j];
+                den += w * reps.weight[j];
+              }
+            }
+        avg[u * P + k] = den > 0.0 ? num / den : g.value[k];
+      }
+    });
   }
   return avg;
 }
@@ -584,9 +570,9 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
-  if (opt.method == saliency_method::approximate && !(opt.approx_cells_per_sigma >= 1.0))
+  if (opt.method == saliency_method::approximate && !(opt.approx_cells_per_sigma >= 0.5))
     return make_error(errc::bad_parameter, no_element, "approx_cells_per_sigma ", opt.approx_cells_per_sigma,
-                      " must be at least 1");
+                      " must be at least 0.5");
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
