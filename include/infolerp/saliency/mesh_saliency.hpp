@@ -52,7 +52,22 @@
 // (tests) 5.0% at 2 cells per σ, 2.0% at 3, 0.11% at 4 (the default); on refined_elephant
 // subdivided once 7.9% at 2, 6.2% at 3, 3.7% at 4, where Lee's local-maxima normalisation
 // amplifies small level errors. On that mesh this mode is no faster than exact (5.5, 8.9 and
-// 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes.
+// 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes. Re-measured there
+// (BM_Saliency_Approx, 2 threads, load average 2.3–2.7): 9.6% at 1 cell per σ (1.96 s wall),
+// 7.9% at 2 (3.6 s), 6.2% at 3 (4.3 s), 3.7% at 4 (5.8 s), 2.8% at 5 (13.6 s), 1.45% at 6
+// (19.8 s); exact took 6.2 s wall in the same run. The issue's goal (0.1 s at 1%) is not met.
+// Lattice schemes tried instead (branch salapprox, issue 4) and not kept, because they fail the
+// 1% test on the bumpy sphere (lattice spacing h = σ / cells per σ, refined_elephant subdivided
+// once, error = relative L2 of the final saliency against exact, CPU time of the whole call):
+//   - splat–gather–slice: trilinear splat of (1, C), node-to-node ball-truncated Gaussian
+//     (σ_n² = σ² − h²/3), trilinear slice: 11.4% at 1 cell per σ (0.42 s CPU), 9.0% at 2
+//     (1.1 s), 8.8% at 4 (7.4 s), 7.2% at 6 (32 s); bumpy sphere 4.2% at 4.
+//   - exact ball averages at the lattice nodes, trilinear slice: 10.8% at 1 (0.63 s CPU), 9.0%
+//     at 2 (1.5 s), 8.3% at 3 (2.6 s), 7.5% at 4 (4.0 s), 6.4% at 5 (5.2 s), 5.1% at 6 (6.1 s,
+//     as slow as exact); bumpy sphere 8.8% at 4.
+// Both converge slowly because S_i = |G(σ) − G(2σ)| is a small difference of two averages
+// (worst level errors 14–33% on the bumpy sphere), and the hard 2σ cutoff (a step of e⁻² in the
+// kernel) is smeared by any lattice: its error is first order in h/σ.
 #include <algorithm>
 #include <array>
 #include <cmath>
