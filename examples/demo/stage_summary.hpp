@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <vector>
 #include "demo.hpp"
 
 namespace infolerp::demo {
@@ -30,11 +31,13 @@ inline std::string shell_quote(const std::string& s) {
 
 inline bool stage_summary(const demo_context& ctx) {
   if (ctx.results.empty()) return true;
-  const double t_ref = ctx.results.front().seconds;
+  auto rows = ctx.results;  // the reference first, then by method name
+  std::stable_sort(rows.begin() + 1, rows.end(), [](const auto& a, const auto& b) { return a.method < b.method; });
+  const double t_ref = rows.front().seconds;
   auto speedup = [&](const method_result& r) { return r.seconds > 0.0 ? t_ref / r.seconds : 0.0; };
 
   std::printf("\n%-13s %9s %9s %10s %7s %10s\n", "method", "time (s)", "speed-up", "PSNR (dB)", "SSIM", "evaluated");
-  for (const auto& r : ctx.results)
+  for (const auto& r : rows)
     std::printf("%-13s %9.3f %8.2fx %10.2f %7.4f %9.2f%%\n", r.method.c_str(), r.seconds, speedup(r), r.psnr, r.ssim,
                 100.0 * r.evaluated);
 
@@ -44,7 +47,7 @@ inline bool stage_summary(const demo_context& ctx) {
     std::ofstream csv(csv_path);
     csv << "method,seconds,speedup,psnr_db,ssim,evaluated_fraction,setting\n";
     char line[256];
-    for (const auto& r : ctx.results) {
+    for (const auto& r : rows) {
       std::snprintf(line, sizeof line, "%s,%.6f,%.4f,%.4f,%.6f,%.6f,", r.method.c_str(), r.seconds, speedup(r), r.psnr,
                     r.ssim, r.evaluated);
       csv << line << '"' << r.setting << "\"\n";
@@ -58,13 +61,13 @@ inline bool stage_summary(const demo_context& ctx) {
 
   // The plot: one point per method, PSNR capped just above the best finite value for exact ones.
   double top = 0.0;
-  for (const auto& r : ctx.results)
+  for (const auto& r : rows)
     if (std::isfinite(r.psnr)) top = std::max(top, r.psnr);
   top = std::ceil(top / 5.0) * 5.0 + 5.0;
   {
     std::ofstream dat(dir / "tradeoff.dat");
     dat << "# seconds psnr_db(exact at " << top << ") method\n";
-    for (const auto& r : ctx.results)
+    for (const auto& r : rows)
       dat << r.seconds << ' ' << (std::isfinite(r.psnr) ? r.psnr : top) << ' ' << r.method << '\n';
     std::ofstream gp(dir / "tradeoff.gp");
     gp << "set terminal pngcairo size 900,600 noenhanced\nset output 'tradeoff.png'\n"
