@@ -1,5 +1,6 @@
 # Builds and runs tests/consumer against infolerp, installed into a temporary prefix
-# (MODE=find_package) or pulled in with add_subdirectory (MODE=add_subdirectory).
+# (MODE=find_package), pulled in with add_subdirectory (MODE=add_subdirectory) or with
+# FetchContent (MODE=fetch_content).
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
