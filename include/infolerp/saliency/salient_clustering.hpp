@@ -180,7 +180,8 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, const mesh_to
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
 // non-finite or negative saliency (names the vertex); clusters == 0 or more clusters than the
 // pool or the triangle count can seed; pool_multiplier < 1; normal_weight < 1 (bad_parameter).
-// Complexity O(iterations · T log T); allocation O(T) (queues hold up to ~3T entries). Serial.
+// Complexity O(iterations · T log T); allocation O(T) (queues hold up to ~3T entries). Serial;
+// pure (concurrent calls on the same mesh are safe).
 template <class M>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,
                                             const salient_clustering_options& opt = {}) {
@@ -283,6 +284,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
 // mean over the vertices of cluster c's triangles (each vertex once); the first term is 0 when
 // max S_c = min S_c. Preconditions: saliency has one value per vertex, cluster one id <
 // cluster_count per triangle, indices valid. Complexity O(V + T); allocation O(T + V + clusters).
+// Serial; pure.
 template <class M>
 std::vector<double> cluster_localized_saliency(const M& m, std::span<const double> saliency,
                                                std::span<const std::uint32_t> cluster, std::uint32_t cluster_count) {
