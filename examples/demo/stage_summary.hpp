@@ -31,8 +31,10 @@ inline std::string shell_quote(const std::string& s) {
 
 inline bool stage_summary(const demo_context& ctx) {
   if (ctx.results.empty()) return true;
-  auto rows = ctx.results;  // the reference first, then by method name
-  std::stable_sort(rows.begin() + 1, rows.end(), [](const auto& a, const auto& b) { return a.method < b.method; });
+  auto rows = ctx.results;  // the reference first, then by method name (ibuffer-2 before ibuffer-16)
+  std::stable_sort(rows.begin() + 1, rows.end(), [](const auto& a, const auto& b) {
+    return a.method.size() != b.method.size() ? a.method.size() < b.method.size() : a.method < b.method;
+  });
   const double t_ref = rows.front().seconds;
   auto speedup = [&](const method_result& r) { return r.seconds > 0.0 ? t_ref / r.seconds : 0.0; };
 
