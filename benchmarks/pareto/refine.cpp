@@ -26,86 +26,11 @@
 #include "infolerp/core/executor.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "pareto.hpp"
-#include "support/embree_tracer.hpp"
-#include "support/procedural.hpp"
+#include "support/walkthrough_scene.hpp"
 
 namespace {
 
-using infolerp::indexed_mesh;
-
-// A box with its own four vertices per face, so a vertex never straddles a crease (a vertex has
-// one shading value; a shared corner would be lit for one face and dark for another).
-void add_box(indexed_mesh& m, std::vector<glm::vec3>& albedo_of_tri, glm::vec3 lo, glm::vec3 hi, glm::vec3 albedo) {
-  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-  for (const auto& f : faces) {
-    const auto base = static_cast<unsigned>(m.positions.size());
-    for (int i = 0; i < 4; ++i) m.positions.push_back(c[f[i]]);
-    m.triangles.push_back({base, base + 1, base + 2});
-    m.triangles.push_back({base, base + 2, base + 3});
-    albedo_of_tri.push_back(albedo);
-    albedo_of_tri.push_back(albedo);
-  }
-}
-
-struct scene {
-  indexed_mesh mesh;
-  std::vector<glm::vec3> albedo;  // per triangle
-  std::vector<glm::vec3> normal;  // per triangle
-  glm::vec3 to_sun = glm::normalize(glm::vec3(0.55f, 0.75f, 0.45f));
-
-  // Traced with Embree 3 (tests/support/embree_tracer.hpp); built by make_scene().
-  std::unique_ptr<infolerp::support::embree_device> device;
-  std::unique_ptr<infolerp::support::embree_scene> tracer;
-  infolerp::hit intersect(const infolerp::ray& r) const { return tracer->intersect(r); }
-  bool occluded(const infolerp::ray& r) const { return tracer->occluded(r); }
-
-  // Lambert with a hard sun shadow and a constant sky term: the reference-style shader.
-  glm::vec3 shade(glm::vec3 p, std::uint32_t t) const {
-    const glm::vec3 n = normal[t];
-    const float cosine = glm::dot(n, to_sun);
-    float sun = 0.0f;
-    if (cosine > 0.0f) {
-      infolerp::support::enable_flush_to_zero();  // every thread traces alike (embree_tracer.hpp)
-      infolerp::ray sr;
-      sr.origin = p + 1e-3f * n;
-      sr.direction = to_sun;
-      sr.tnear = 1e-4f;
-      sun = occluded(sr) ? 0.0f : cosine;
-    }
-    return albedo[t] * (0.18f + 0.85f * sun);
-  }
-};
-
-scene make_scene() {
-  scene s;
-  // Ground: 40 × 40 m in 4 × 4 quads (32 triangles, 10 m each): vertex shading alone sees no shadow.
-  s.mesh = infolerp::support::make_plane(4, 4, 40.0f);
-  s.albedo.assign(s.mesh.triangles.size(), glm::vec3(0.75f, 0.68f, 0.55f));
-  // Portico: six columns under a roof slab along the street.
-  for (int i = 0; i < 6; ++i) {
-    const float x = -11.0f + 4.0f * float(i);
-    add_box(s.mesh, s.albedo, {x, 4.0f, 0.0f}, {x + 0.7f, 4.7f, 5.0f}, glm::vec3(0.85f, 0.83f, 0.78f));
-  }
-  add_box(s.mesh, s.albedo, {-12.0f, 3.6f, 5.0f}, {11.5f, 8.0f, 5.6f}, glm::vec3(0.6f, 0.35f, 0.3f));
-  // City wall along the left of the street.
-  add_box(s.mesh, s.albedo, {-16.0f, -14.0f, 0.0f}, {-15.0f, 3.0f, 4.0f}, glm::vec3(0.7f, 0.62f, 0.5f));
-  // Temple column: tall, casting a long shadow across the street toward the viewer.
-  add_box(s.mesh, s.albedo, {1.0f, -2.6f, 0.0f}, {2.2f, -1.4f, 10.0f}, glm::vec3(0.9f, 0.9f, 0.86f));
-  for (const glm::uvec3 t : s.mesh.triangles)
-    s.normal.push_back(glm::normalize(glm::cross(s.mesh.positions[t.y] - s.mesh.positions[t.x],
-                                                 s.mesh.positions[t.z] - s.mesh.positions[t.x])));
-  // The sun is behind the portico, so its shadows fall into the street toward the viewer.
-  s.to_sun = glm::normalize(glm::vec3(-0.4f, 0.55f, 0.5f));
-  s.device = std::make_unique<infolerp::support::embree_device>();
-  s.tracer = std::make_unique<infolerp::support::embree_scene>(*s.device);
-  if (!s.tracer->add_mesh(s.mesh).ok() || !s.tracer->commit().ok()) {
-    std::fprintf(stderr, "embree scene build failed\n");
-    std::exit(1);
-  }
-  return s;
-}
+using scene = infolerp::support::walkthrough_scene;
 
 double psnr(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
   double se = 0.0;
@@ -192,9 +117,13 @@ int pareto_refine(int argc, char** argv) {
   if (png_path.empty()) png_path = csv_path.substr(0, csv_path.rfind('.')) + ".png";
   const std::string stem = png_path.substr(0, png_path.rfind('.'));
 
-  const scene sc = make_scene();
-  const infolerp::pinhole_camera cam{.eye = {0.0f, -19.0f, 5.5f}, .target = {0.0f, 1.0f, 1.0f}, .up = {0, 0, 1},
-                                     .vertical_fov_degrees = 55.0f, .width = width, .height = height};
+  auto built = infolerp::support::make_walkthrough_scene();
+  if (!built) {
+    std::fprintf(stderr, "%s\n", built.error().message().c_str());
+    return 1;
+  }
+  const scene& sc = *built;
+  const infolerp::pinhole_camera cam = infolerp::support::walkthrough_camera(width, height);
 #ifdef _OPENMP
   infolerp::openmp_executor exec{};
 #else

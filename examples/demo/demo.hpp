@@ -7,23 +7,43 @@
 #include <cstdio>
 #include <functional>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 #include <glm/geometric.hpp>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include "support/demo_scene.hpp"
+#include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/image.hpp"
 #include "support/reference_shader.hpp"
+#include "support/ssim.hpp"
 
 namespace infolerp::demo {
 
 struct demo_options {
   int width = 1025;                  // --size W H
   int height = 1025;
-  int threads = 0;                   // --threads N (0 = all cores)
+  int threads = 0;                   // --threads N (0 = all cores); every stage uses this many
   std::filesystem::path out_dir = "infolerp-out";  // --out DIR
   std::string mesh_path;             // --mesh FILE (empty: built-in scene only)
   support::shader_options shader;    // --ao N, --soft N
+  std::uint32_t passes = 4;          // --passes K: I-Buffer passes of ibuffer.png; 0 = auto (pass controller)
+  std::map<std::string, float> thresholds;  // --threshold CHANNEL=VALUE: channel (visibility,
+                                            // orientation, stretch) -> JS threshold in [0, 1], for the clusters stage
+};
+
+// One rendering method's result against the reference, for the table, summary.csv and tradeoff.png.
+struct method_result {
+  std::string method;        // e.g. "reference", "ibuffer-3"
+  std::string setting;       // human-readable settings
+  double seconds = 0.0;      // wall time of the frame
+  double psnr = 0.0;         // dB against the reference (+inf when identical)
+  double ssim = 1.0;         // mean SSIM of the display luma (NaN for images below 11x11)
+  double evaluated = 1.0;    // fully evaluated samples per pixel
 };
 
 struct demo_context {
@@ -32,7 +52,36 @@ struct demo_context {
   const support::reference_shader& shader;
   support::image reference;               // the full per-pixel render (filled by the first stage)
   support::render_stats reference_stats;  // its time and ray count
+  std::vector<method_result> results;     // every method run so far, the reference first
 };
+
+// Display luma of every pixel (what SSIM compares).
+inline std::vector<float> luma_of(const support::image& img) {
+  std::vector<float> l(img.pixels.size());
+  for (std::size_t i = 0; i < l.size(); ++i) l[i] = support::display_luma(img.pixels[i]);
+  return l;
+}
+
+// Records a method's frame: PSNR and SSIM against ctx.reference (sizes match by construction).
+inline const method_result& add_result(demo_context& ctx, std::string method, std::string setting, double seconds,
+                                       double evaluated, const support::image& img) {
+  method_result r{std::move(method), std::move(setting), seconds, 0.0, std::nan(""), evaluated};
+  const auto p = support::psnr(ctx.reference, img);
+  r.psnr = p ? *p : std::nan("");
+  const auto s = support::ssim(luma_of(ctx.reference), luma_of(img), img.width, img.height);
+  if (s) r.ssim = *s;
+  ctx.results.push_back(std::move(r));
+  return ctx.results.back();
+}
+
+// OpenMP threads for a stage: --threads N, or OpenMP's default.
+inline int omp_threads(const demo_options& o) {
+#ifdef _OPENMP
+  return o.threads > 0 ? o.threads : omp_get_max_threads();
+#else
+  return o.threads > 0 ? o.threads : 1;
+#endif
+}
 
 // A one-line progress bar on stderr: call with (done, total); prints only when the
 // bar grows and ends the line at 100%. Not thread-safe (callers serialise).
@@ -75,12 +124,12 @@ inline bool save_png(const demo_context& ctx, const support::image& img, const s
 
 // An image of the scene coloured per surface point: colour(geometry, triangle, barycentric) for
 // each primary hit, dimmed by a headlight term so shapes stay readable; sky pixels are black.
-// Used by the clusters and saliency stages. Parallel over rows (OpenMP).
+// Used by the clusters and saliency stages. Parallel over rows (OpenMP, --threads).
 inline support::image render_false_colour(
     const demo_context& ctx, const std::function<glm::vec3(std::uint32_t, std::uint32_t, glm::vec2)>& colour) {
   const int w = ctx.options.width, h = ctx.options.height;
   support::image img(w, h);
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(omp_threads(ctx.options))
   for (int y = 0; y < h; ++y) {
     support::enable_flush_to_zero();
     for (int x = 0; x < w; ++x) {

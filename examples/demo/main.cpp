@@ -1,16 +1,21 @@
 // infolerp_demo: renders the built-in demo scene (plus an optional --mesh) with the full
-// per-pixel reference shader and writes DIR/reference.png. Later stages add clustering,
-// saliency and the I-Buffer upsampler on top of the same context.
+// per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
+// saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png) and the
+// summary (a printed table, summary.csv, tradeoff.png). Any error gives one line on stderr and
+// a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
+// an unwritable output directory).
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <system_error>
 #include "demo.hpp"
 #include "stage_clusters.hpp"
 #include "stage_saliency.hpp"
+#include "stage_summary.hpp"
 #include "stage_upsample.hpp"
 
 namespace demo = infolerp::demo;
@@ -22,12 +27,33 @@ constexpr const char* usage =
     "usage: infolerp_demo [options]\n"
     "  --mesh FILE     add a mesh (OFF/OBJ/PLY/... via assimp) to the built-in scene\n"
     "  --size W H      image size in pixels (default 1025 1025)\n"
-    "  --threads N     worker threads (default: all cores)\n"
+    "  --passes K|auto I-Buffer passes of ibuffer.png (1-16, default 4); auto: the pass controller\n"
+    "                  (frame-time bounds 1/60-1/30 s, at most 4 passes)\n"
+    "  --threshold CHANNEL=VALUE\n"
+    "                  Jensen-Shannon threshold in [0, 1] of a clustering channel: visibility,\n"
+    "                  orientation or stretch (repeatable)\n"
+    "  --threads N     worker threads of every stage (default: all cores)\n"
     "  --ao N          ambient-occlusion rays per pixel (default 64)\n"
     "  --soft N        soft-shadow rays per pixel toward the area light (default 16)\n"
     "  --packets       trace each pixel's AO and soft-shadow rays as 16-ray packets\n"
     "  --out DIR       output directory (default infolerp-out)\n"
     "  --help          this text\n";
+
+// CHANNEL=VALUE with a known channel and a value in [0, 1]; else an error message.
+std::optional<std::string> parse_threshold(std::string_view text, demo::demo_options& o) {
+  const auto eq = text.find('=');
+  if (eq == std::string_view::npos) return "--threshold needs CHANNEL=VALUE, e.g. visibility=0.48";
+  const std::string channel(text.substr(0, eq));
+  if (channel != "visibility" && channel != "orientation" && channel != "stretch")
+    return "--threshold: unknown channel '" + channel + "' (visibility, orientation or stretch)";
+  const std::string_view number = text.substr(eq + 1);
+  float value = 0.0f;
+  const auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
+  if (number.empty() || ec != std::errc{} || end != number.data() + number.size() || !(value >= 0.0f && value <= 1.0f))
+    return "--threshold: " + channel + " value '" + std::string(number) + "' is not a number in [0, 1]";
+  o.thresholds[channel] = value;
+  return std::nullopt;
+}
 
 bool parse_int(std::string_view text, int lo, int hi, int& out) {
   int value = 0;
@@ -70,6 +96,19 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
       if (!need(1) || !parse_int(argv[++i], 0, 4096, n))
         return fail(std::string(arg) + " needs an integer in [0, 4096]");
       (arg == "--ao" ? o.shader.ao_rays : o.shader.soft_shadow_rays) = static_cast<unsigned>(n);
+    } else if (arg == "--passes") {
+      int k = 0;
+      if (!need(1)) return fail("--passes needs K (1-16) or auto");
+      if (std::string_view(argv[++i]) == "auto") {
+        o.passes = 0;
+      } else if (parse_int(argv[i], 1, 16, k)) {
+        o.passes = static_cast<std::uint32_t>(k);
+      } else {
+        return fail("--passes needs K (1-16) or auto, not '" + std::string(argv[i]) + "'");
+      }
+    } else if (arg == "--threshold") {
+      if (!need(1)) return fail("--threshold needs CHANNEL=VALUE");
+      if (auto error = parse_threshold(argv[++i], o)) return fail(*error);
     } else if (arg == "--packets") {
       o.shader.packets = true;
     } else if (arg == "--out") {
@@ -96,6 +135,10 @@ bool stage_reference(demo::demo_context& ctx) {
   ctx.reference_stats = *stats;
   std::printf("reference: %.3f s, %llu rays, %.2f Mrays/s\n", stats->seconds,
               static_cast<unsigned long long>(stats->rays), stats->rays_per_second() * 1e-6);
+  demo::add_result(ctx, "reference",
+                   "per-pixel evaluation, AO " + std::to_string(o.shader.ao_rays) + ", soft shadow " +
+                       std::to_string(o.shader.soft_shadow_rays) + " rays",
+                   stats->seconds, 1.0, ctx.reference);
   return demo::save_png(ctx, ctx.reference, "reference.png");
 }
 
@@ -113,7 +156,8 @@ int main(int argc, char** argv) {
   }
 
   support::enable_flush_to_zero();
-  const support::embree_device device;
+  const std::string embree_config = options->threads > 0 ? "threads=" + std::to_string(options->threads) : "";
+  const support::embree_device device(embree_config.c_str());
   auto scene = support::make_demo_scene(device, {.mesh_path = options->mesh_path});
   if (!scene) {
     demo::report(scene.error());
@@ -124,11 +168,17 @@ int main(int argc, char** argv) {
   std::printf("scene: %zu objects, %zu triangles\n", scene->objects.size(), triangles);
 
   const support::reference_shader shader(*scene, options->shader);
-  demo::demo_context ctx{*options, *scene, shader, {}, {}};
+  if (!options->thresholds.empty()) {
+    std::printf("thresholds:");
+    for (const auto& [channel, value] : options->thresholds) std::printf(" %s=%g", channel.c_str(), static_cast<double>(value));
+    std::printf(" (for the clusters stage)\n");
+  }
+  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}};
   if (!stage_reference(ctx)) return 1;
   support::scene_clustering clusters;
   if (!demo::stage_clusters(ctx, clusters)) return 1;
   if (!demo::stage_saliency(ctx)) return 1;
   if (!demo::stage_upsample(ctx, &clusters)) return 1;
+  if (!demo::stage_summary(ctx)) return 1;
   return 0;
 }

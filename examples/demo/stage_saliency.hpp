@@ -34,7 +34,7 @@ inline bool stage_saliency(const demo_context& ctx, saliency_method method = sal
     std::vector<std::uint32_t> remap;
     const indexed_mesh welded = support::weld_positions(object.mesh, remap);
 #ifdef _OPENMP
-    auto s = compute_saliency(welded, {.method = method}, openmp_executor{});
+    auto s = compute_saliency(welded, {.method = method}, openmp_executor{ctx.options.threads});
 #else
     auto s = compute_saliency(welded, {.method = method});
 #endif

@@ -1,5 +1,6 @@
 # Builds and runs tests/consumer against infolerp, installed into a temporary prefix
-# (MODE=find_package) or pulled in with add_subdirectory (MODE=add_subdirectory).
+# (MODE=find_package), pulled in with add_subdirectory (MODE=add_subdirectory) or with
+# FetchContent (MODE=fetch_content).
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -8,6 +9,9 @@ function(run)
   endif()
 endfunction()
 set(consumer_args -S ${SOURCE_DIR}/tests/consumer -B ${WORK_DIR}/consumer -DCONSUMER_MODE=${MODE})
+if(CXX)  # the compiler of the build that runs the test (g++, or clang++ in .ci/clang.sh)
+  list(APPEND consumer_args -DCMAKE_CXX_COMPILER=${CXX})
+endif()
 if(MODE STREQUAL "find_package")
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/lib -DINFOLERP_BUILD_TESTS=OFF
       -DINFOLERP_BUILD_BENCHMARKS=OFF -DINFOLERP_BUILD_EXAMPLES=OFF -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix)

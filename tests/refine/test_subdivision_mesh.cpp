@@ -43,7 +43,7 @@ double min_angle(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
 double shape_bound(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
   double bound = min_angle(a, b, c);
   const std::array<glm::dvec3, 3> p{a, b, c};
-  for (int k = 0; k < 3; ++k) {
+  for (std::size_t k = 0; k < 3; ++k) {
     const glm::dvec3 pa = p[k], pb = p[(k + 1) % 3], pc = p[(k + 2) % 3], m = 0.5 * (pa + pb);
     bound = std::min({bound, min_angle(pa, m, pc), min_angle(m, pb, pc)});
   }

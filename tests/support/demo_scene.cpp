@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/mesh/validate.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
@@ -90,9 +92,18 @@ indexed_mesh transformed(const indexed_mesh& src, const glm::mat4& m) {
 
 // Loads the user's mesh (Y-up, as most OBJ/OFF/PLY files are: turned to this scene's Z-up) and
 // scales it so its largest extent is `size`, standing on the ground at `where` (x, y).
+// OFF files are read as written (read_off) and every mesh is validated before use: indices in
+// range, finite positions (all vertices, as they all enter the bounds). Degenerate triangles and
+// non-manifold edges are accepted: the tracer and the demo's stages handle them.
 result<indexed_mesh> load_fitted_mesh(const std::string& path, float size, glm::vec2 where) {
-  auto loaded = load_mesh(path);
+  const bool off = path.size() >= 4 && (path.ends_with(".off") || path.ends_with(".OFF"));
+  auto loaded = off ? read_off(path) : load_mesh(path);
   if (!loaded) return loaded.error();
+  if (auto s = validate_mesh(*loaded, {.allow_degenerate = true, .allow_non_manifold = true, .check_unused_vertices = true}); !s) {
+    std::string_view m = s.message();
+    if (m.starts_with("infolerp: ")) m.remove_prefix(10);
+    return make_error(s.code(), s.element(), "mesh '", path, "': ", std::string(m));
+  }
   *loaded = transformed(*loaded, glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f)));
   const bounding_box box = mesh_bounds(*loaded);
   const glm::dvec3 extent = box.hi - box.lo;

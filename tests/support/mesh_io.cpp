@@ -3,12 +3,18 @@
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <charconv>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <system_error>
 
 namespace infolerp::support {
 
 result<indexed_mesh> load_mesh(const std::string& path) {
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr)
     return make_error(errc::bad_parameter, no_element, "cannot load mesh '", path, "': ", importer.GetErrorString());
   indexed_mesh out;
@@ -25,6 +31,67 @@ result<indexed_mesh> load_mesh(const std::string& path) {
   }
   if (out.triangles.empty())
     return make_error(errc::empty_input, no_element, "mesh file '", path, "' holds no triangles");
+  return out;
+}
+
+result<indexed_mesh> read_off(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return make_error(errc::bad_parameter, no_element, "cannot open mesh '", path, "'");
+  // Whitespace-separated tokens, '#' comments to the end of the line; counts the lines read.
+  std::size_t line_no = 0;
+  std::istringstream line;
+  auto next = [&](std::string& token) {
+    while (!(line >> token)) {
+      std::string text;
+      if (!std::getline(in, text)) return false;
+      ++line_no;
+      if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
+      line.clear();
+      line.str(text);
+    }
+    return true;
+  };
+  auto fail = [&](const char* what) {
+    return make_error(errc::bad_parameter, no_element, "mesh '", path, "' line ", line_no, ": ", what);
+  };
+  auto number = [&](auto& value) {
+    std::string token;
+    if (!next(token)) return false;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    return ec == std::errc{} && end == token.data() + token.size();
+  };
+  std::string header;
+  if (!next(header) || header != "OFF") return fail("not an OFF file (expected the header 'OFF')");
+  std::size_t nv = 0, nf = 0, ne = 0;
+  if (!number(nv) || !number(nf) || !number(ne)) return fail("expected the counts 'vertices faces edges'");
+  indexed_mesh out;
+  out.positions.resize(nv);
+  for (auto& p : out.positions) {
+    std::string token;
+    for (int c = 0; c < 3; ++c) {
+      // strtof-compatible spellings (nan, inf) are read as such; validate_mesh rejects them.
+      if (!next(token)) return fail("truncated vertex list");
+      char* end = nullptr;
+      p[c] = std::strtof(token.c_str(), &end);
+      if (end != token.c_str() + token.size()) return fail("vertex coordinate is not a number");
+    }
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    std::size_t n = 0;
+    if (!number(n)) return fail("truncated or non-numeric face list");
+    if (n < 3) return fail("face with fewer than 3 vertices");
+    std::uint32_t first = 0, prev = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      std::uint32_t v = 0;
+      if (!number(v)) return fail("truncated or non-numeric face list");
+      if (k == 0) first = v;
+      if (k >= 2) out.triangles.push_back({first, prev, v});
+      prev = v;
+    }
+    line.str({});  // per-face colours after the indices are ignored
+    line.clear();
+  }
+  if (out.triangles.empty()) return make_error(errc::empty_input, no_element, "mesh file '", path, "' holds no triangles");
   return out;
 }
 

@@ -133,6 +133,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
 
     // 2. The band.
     const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
+    const std::uint32_t cluster_a = ca;  // clang++ 14 cannot capture a structured binding
     auto prefers_other = [&](std::uint32_t i) {
       const std::uint32_t c = s.class_of(i);
       if (stamp[c] != pair_index) {
@@ -140,7 +141,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         js_a[c] = s.divergence(c, seed_a);
         js_b[c] = s.divergence(c, seed_b);
       }
-      return label[i] == ca ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
+      return label[i] == cluster_a ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
     };
     std::vector<std::uint8_t> in_band(n, 0);
     std::vector<std::uint32_t> band;

@@ -27,6 +27,8 @@ concept executor = requires(E& e, std::size_t n, std::size_t grain, detail::rang
   e.parallel_for(n, grain, fn);
 };
 
+// For `static_assert(check_executor<E>())` at entry points: one readable message when E is not an
+// executor. Compile time only.
 template <class E>
 constexpr bool check_executor() {
   static_assert(executor<E>,
@@ -35,7 +37,8 @@ constexpr bool check_executor() {
   return executor<E>;
 }
 
-// Runs everything on the calling thread, in order. The default executor.
+// Runs everything on the calling thread, in order. The default executor. No allocation;
+// stateless, so one object may be shared by any number of threads.
 struct serial_executor {
   template <class F>
   void parallel_for(std::size_t n, std::size_t /*grain*/, F&& fn) const {
@@ -46,6 +49,8 @@ struct serial_executor {
 #ifdef _OPENMP
 // OpenMP worksharing over chunks of `grain` (dynamic schedule). Offered only when the
 // translation unit is compiled with OpenMP. threads = 0 uses OpenMP's default.
+// Preconditions: not called from inside another OpenMP parallel region if nested parallelism is
+// off (the call then runs on one thread). O(n / grain) scheduling; allocation is OpenMP's own.
 struct openmp_executor {
   int threads = 0;
   template <class F>
@@ -63,7 +68,7 @@ struct openmp_executor {
 };
 #endif
 
-// Number of fixed chunks of `grain` elements covering n elements.
+// Number of fixed chunks of `grain` elements covering n elements (grain 0 counts as 1). O(1).
 constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
   grain = grain == 0 ? 1 : grain;
   return (n + grain - 1) / grain;
@@ -72,6 +77,8 @@ constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
 // Calls fn(chunk, begin, end) for each fixed chunk [chunk·grain, min(n, (chunk+1)·grain)),
 // in parallel through the executor. Chunk boundaries depend only on n and grain, so a per-chunk
 // reduction combined in chunk order gives the same bits for any executor and thread count.
+// Preconditions: fn is safe to call concurrently for different chunks. O(chunks) scheduling,
+// no allocation of its own (the executor's only).
 template <class E, class F>
   requires executor<std::remove_cvref_t<E>>
 void for_each_chunk(E&& exec, std::size_t n, std::size_t grain, F&& fn) {

@@ -16,6 +16,9 @@
 
 namespace infolerp {
 
+// Every accessor is called from the library's worker threads concurrently (const calls only),
+// is expected to be O(1) and should not allocate; the library reads each value as often as it
+// needs it and keeps no copy of the mesh.
 template <class M>
 struct mesh_traits {
   static std::size_t vertex_count(const M& m) requires requires { { m.vertex_count() } -> std::convertible_to<std::size_t>; }
@@ -88,7 +91,7 @@ constexpr bool check_mesh() {
   return mesh<M>;
 }
 
-// Shorthands used throughout the library.
+// Shorthands used throughout the library: O(1) forwarding to mesh_traits, no allocation.
 template <mesh M> std::size_t mesh_vertex_count(const M& m) { return mesh_traits<M>::vertex_count(m); }
 template <mesh M> std::size_t mesh_triangle_count(const M& m) { return mesh_traits<M>::triangle_count(m); }
 template <mesh M> glm::vec3 mesh_position(const M& m, std::size_t v) { return mesh_traits<M>::position(m, v); }

@@ -35,6 +35,7 @@ inline constexpr std::uint64_t no_element = ~std::uint64_t{0};
 // The "none" value of 32-bit ids (triangles, clusters, edges).
 inline constexpr std::uint32_t invalid_id = 0xffffffffu;
 
+// A short English name of the code (static storage). O(1), no allocation, thread-safe.
 inline constexpr const char* to_string(errc code) noexcept {
   switch (code) {
     case errc::ok: return "ok";
@@ -54,7 +55,8 @@ inline constexpr const char* to_string(errc code) noexcept {
 
 // The outcome of an operation: ok, or an error code with a message and the offending element
 // (a triangle, vertex, bin or pixel index; no_element when none applies).
-// Allocation: the message string, only on error.
+// Allocation: the message string, only on error. Accessors O(1), no allocation; like any value
+// type, safe to read from several threads, not to modify concurrently.
 class [[nodiscard]] status {
  public:
   status() = default;
@@ -74,6 +76,7 @@ class [[nodiscard]] status {
 };
 
 // A value or the status that explains why there is none (std::expected is C++23).
+// Accessors O(1), no allocation; thread-safety as for T.
 template <class T>
 class [[nodiscard]] result {
  public:
@@ -113,7 +116,7 @@ void append_part(std::string& s, N part) {
 
 // An error status with a message built from pieces, for example
 //   make_error(errc::index_out_of_range, t, "triangle ", t, ": vertex ", v, " out of range")
-// Allocation: the message string.
+// Complexity O(total message length). Allocation: the message string. Thread-safe.
 template <class... Parts>
 status make_error(errc code, std::uint64_t element, const Parts&... parts) {
   std::string message = "infolerp: ";

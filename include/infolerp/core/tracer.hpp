@@ -50,6 +50,8 @@ concept batch_intersection_tracer = tracer<T> && requires(const T& t, std::span<
   t.intersect(rays, out);
 };
 
+// For `static_assert(check_tracer<T>())` at entry points: one readable message per missing
+// member. Compile time only.
 template <class T>
 constexpr bool check_tracer() {
   static_assert(requires(const T& t, const ray& r) { { t.occluded(r) } -> std::convertible_to<bool>; },
@@ -60,7 +62,8 @@ constexpr bool check_tracer() {
 }
 
 // Occlusion of many rays: the tracer's batch overload when it has one, else one ray at a time.
-// Preconditions: out.size() >= rays.size(). Allocation: none.
+// Preconditions: out.size() >= rays.size(). Complexity: rays.size() tracer queries.
+// Allocation: none (the tracer's own aside). Thread-safe when the tracer's const calls are.
 template <tracer T>
 void trace_occluded(const T& t, std::span<const ray> rays, std::span<std::uint8_t> out) {
   if constexpr (batch_occlusion_tracer<T>) {
@@ -71,6 +74,7 @@ void trace_occluded(const T& t, std::span<const ray> rays, std::span<std::uint8_
 }
 
 // Closest hits of many rays, batched when the tracer can. Preconditions: out.size() >= rays.size().
+// Complexity: rays.size() tracer queries. Allocation: none. Thread-safe when the tracer's const calls are.
 template <tracer T>
 void trace_intersect(const T& t, std::span<const ray> rays, std::span<hit> out) {
   if constexpr (batch_intersection_tracer<T>) {

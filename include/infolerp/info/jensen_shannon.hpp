@@ -168,7 +168,8 @@ inline double js_divergence(std::span<const float> p, std::span<const float> q, 
 
 // JS(Y|a,b) of the clustering paper: rows p(Y|a), p(Y|b) weighted by the input probabilities
 // p(a), p(b), normalised to π₁ = p(a)/(p(a)+p(b)); equal weights when both are 0.
-// Preconditions as js_divergence, plus p_a, p_b finite and >= 0.
+// Preconditions as js_divergence, plus p_a, p_b finite and >= 0. Complexity O(n), no
+// allocation, thread-safe.
 inline double js_channel(std::span<const double> row_a, std::span<const double> row_b, double p_a, double p_b) noexcept {
   const double total = p_a + p_b;
   return js_divergence(row_a, row_b, total > 0.0 ? p_a / total : 0.5);

@@ -19,6 +19,8 @@ namespace infolerp {
 
 // Non-owning view. texcoords, when present, hold 3 per triangle (per corner, so UV seams are
 // representable); normals, when present, one per vertex. The viewed arrays must outlive the view.
+// Accessors: preconditions v < vertex_count(), t < triangle_count(), corner < 3 (unchecked);
+// O(1), no allocation, safe for concurrent const calls.
 struct mesh_view {
   std::span<const glm::vec3> positions;
   std::span<const glm::uvec3> triangles;
@@ -36,6 +38,8 @@ struct mesh_view {
 };
 
 // Owning mesh. Same layout rules as mesh_view; keyframes[k][v] are animated positions.
+// Accessors as mesh_view's (O(1), unchecked, no allocation, concurrent const calls are safe);
+// view() is O(1) and does not copy.
 struct indexed_mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
@@ -58,7 +62,8 @@ struct indexed_mesh {
 };
 
 // Zero-copy view over raw arrays: vertex v's position is the three floats at
-// positions + v * stride_bytes; triangle t is indices[3t .. 3t+2].
+// positions + v * stride_bytes; triangle t is indices[3t .. 3t+2]. The arrays must outlive the
+// view. Accessors: unchecked indices, O(1), no allocation, safe for concurrent const calls.
 class strided_mesh_view {
  public:
   std::size_t vertex_count() const { return vertex_count_; }

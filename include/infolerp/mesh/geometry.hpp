@@ -25,6 +25,7 @@ triangle_corners corners(const M& m, std::size_t t) {
   return {glm::dvec3(mesh_position(m, tri.x)), glm::dvec3(mesh_position(m, tri.y)), glm::dvec3(mesh_position(m, tri.z))};
 }
 
+// Per-triangle helpers below: O(1), no allocation, pure (thread-safe).
 // Unnormalised normal (p1-p0)×(p2-p0); its length is twice the area.
 inline glm::dvec3 area_vector(const triangle_corners& c) { return glm::cross(c.p1 - c.p0, c.p2 - c.p0); }
 
@@ -65,6 +66,7 @@ std::vector<double> face_areas(const M& m) {
   return out;
 }
 
+// Axis-aligned box, empty until extended. Members O(1), no allocation.
 struct bounding_box {
   glm::dvec3 lo{std::numeric_limits<double>::infinity()};
   glm::dvec3 hi{-std::numeric_limits<double>::infinity()};

@@ -19,6 +19,9 @@
 
 namespace infolerp {
 
+// Edges, edge-face incidence and the dual graph. Accessors: preconditions e < edge_count(),
+// t < triangle_count() (unchecked); O(1), no allocation (spans view the vectors); safe for
+// concurrent const calls.
 struct mesh_topology {
   std::vector<glm::uvec2> edges;               // unique edges (v0 < v1), sorted
   std::vector<std::uint32_t> triangle_edges;   // 3 per triangle: edge from corner c to c+1
@@ -139,7 +142,7 @@ struct components {
   std::uint32_t count = 0;
 };
 
-// Complexity O(T + neighbours), allocation O(T). Deterministic.
+// Complexity O(T + neighbours), allocation O(T). Deterministic; thread-safe (reads topo only).
 inline components connected_components(const mesh_topology& topo) {
   const std::size_t nt = topo.triangle_count();
   components out;
@@ -163,7 +166,8 @@ inline components connected_components(const mesh_topology& topo) {
   return out;
 }
 
-// Indices of the edges with exactly one triangle, ascending. O(E).
+// Indices of the edges with exactly one triangle, ascending. O(E); allocates the result.
+// Thread-safe (reads topo only).
 inline std::vector<std::uint32_t> boundary_edges(const mesh_topology& topo) {
   std::vector<std::uint32_t> out;
   for (std::size_t e = 0; e < topo.edge_count(); ++e)

@@ -36,7 +36,8 @@ struct validate_options {
 // safe on garbage indices and positions.
 // Complexity: O(T) for checks 1-4 (plus O(V) with check_unused_vertices); check 5 builds the
 // topology, O(V + T). Allocation: none for checks 1-4; the topology (~60 bytes per triangle)
-// for check 5, released before returning; the message on error.
+// for check 5, released before returning; the message on error. Serial; thread-safe for
+// concurrent calls on the same mesh (const reads only).
 template <class M>
 status validate_mesh(const M& m, const validate_options& options = {}) {
   static_assert(check_mesh<M>());

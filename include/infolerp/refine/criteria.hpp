@@ -51,7 +51,7 @@ struct criteria_options {
   std::uint64_t seed = 1;                // RND: random sequence
 };
 
-// Checks option ranges. Errors name the member.
+// Checks option ranges. Errors name the member. O(1); allocation: the message on error.
 inline status validate(const criteria_options& o) {
   if (!(o.s_req >= 0.0f && o.s_req <= 1.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.s_req ", o.s_req, " outside [0, 1]");
@@ -186,6 +186,8 @@ inline void select_rnd(const refinement_frame& f, const criteria_options& o, cri
 }
 
 // Runs the configured criterion. Returns the number of ids appended (0: nothing qualifies).
+// Complexity and allocation: those of select_nld_os / select_nld_is / select_rnd. Serial;
+// not thread-safe for the same criterion_state (RND advances its random sequence).
 inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
                                          std::vector<std::uint32_t>& out) {
   const std::size_t before = out.size();

@@ -23,6 +23,7 @@
 namespace infolerp {
 
 // Rec. 709 luminance of a linear RGB colour (the weights the paper's Drago tone mapper uses).
+// O(1), no allocation, pure.
 inline constexpr float luminance(glm::vec3 rgb) noexcept {
   return 0.2126f * rgb.r + 0.7152f * rgb.g + 0.0722f * rgb.b;
 }

@@ -101,10 +101,12 @@ struct driver_options {
   std::size_t grain = 4096;                                                // executor grain (pixels, vertices)
 };
 
+// Not thread-safe: one call at a time per object (each call runs in parallel through the
+// executor). Accessors below are O(1) and allocate nothing.
 class progressive_refiner {
  public:
   // Takes over a subdivision mesh (possibly already tessellated, §4.1 of the clustering paper).
-  // Errors: options out of range.
+  // Errors: options out of range. O(1) besides the move; no allocation.
   static result<progressive_refiner> create(subdivision_mesh mesh, driver_options options = {}) {
     if (auto st = validate(options.criteria); !st) return st;
     if (options.grain == 0) return make_error(errc::bad_parameter, no_element, "driver_options.grain must be >= 1");
@@ -159,7 +161,9 @@ class progressive_refiner {
   // One batch of stage 2: the criterion selects up to R leaves, they are split, pixels are
   // re-located and new visible vertices shaded. Returns false when nothing was selected, the
   // shading budget is reached or max_batches ran (then stage 2's figures are final).
-  // Preconditions: start() succeeded.
+  // Preconditions: start() succeeded. Complexity: the criterion's selection (criteria.hpp) +
+  // O(R) splits + O(pixels of the split leaves) re-location + the new vertices' shading.
+  // Allocation: the split triangles and vertices, the visible-set rebuild (O(visible)).
   template <class Shade, class E>
   bool refine_batch(Shade&& shade, E&& exec) {
     if (done()) {
@@ -192,7 +196,8 @@ class progressive_refiner {
     return true;
   }
 
-  // start() then batches until done. Returns the Table 1 figures.
+  // start() then batches until done. Returns the Table 1 figures. Errors, complexity and
+  // allocation: those of start() plus every refine_batch().
   template <class T, class Camera, class Shade, class E>
   result<refinement_report> run(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
     if (auto st = start(tracer, camera, shade, exec); !st) return st;

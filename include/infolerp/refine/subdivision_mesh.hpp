@@ -185,6 +185,9 @@ struct screen_fraction_test {
   }
 };
 
+// Not thread-safe for modification (split, tessellate); const members may be called
+// concurrently. Accessors: preconditions v < vertex_count(), t < triangle_count() (unchecked);
+// O(1), no allocation.
 class subdivision_mesh {
  public:
   // Builds the hierarchy roots (triangle t of the input is hierarchy triangle t, vertex v is
@@ -322,12 +325,13 @@ class subdivision_mesh {
     return {t, glm::vec3(static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2]))};
   }
 
-  // Appends the ids of the current leaves, ascending. O(triangle_count()).
+  // Appends the ids of the current leaves, ascending. O(triangle_count()); allocation: growth of out.
   void leaves(std::vector<std::uint32_t>& out) const {
     for (std::size_t t = 0; t < tris_.size(); ++t)
       if (tris_[t].is_leaf()) out.push_back(static_cast<std::uint32_t>(t));
   }
   // The current leaves as a mesh over all vertices (leaf i is the i-th leaf in id order).
+  // O(V + triangle_count()); allocates the copy of the positions and the leaf triangles.
   [[nodiscard]] indexed_mesh leaf_mesh() const {
     indexed_mesh out;
     out.positions = positions_;
@@ -340,7 +344,8 @@ class subdivision_mesh {
   // Clustering paper §4.1: splits (closure only, no propagation) every leaf for which
   // needs_split(p0, p1, p2) holds, repeatedly, until none does or the leaf reached max_level.
   // Use screen_fraction_test for the paper's criterion. Returns the number of selections.
-  // Complexity O(final triangles · rounds) with rounds <= max_level.
+  // Complexity O(final triangles · rounds) with rounds <= max_level. Allocation: the new
+  // triangles and vertices plus a work list of leaf ids. needs_split is called serially.
   template <class NeedsSplit>
   std::size_t tessellate(NeedsSplit&& needs_split, std::uint32_t max_level = 8) {
     std::size_t selections = 0;

@@ -53,6 +53,7 @@ struct cluster_table {
 // Per-cluster attributes. Errors: mesh errors as mean_curvature; saliency.size() != V or
 // cluster.size() != T (bad_size); a cluster id >= cluster_count (names the triangle); a
 // negative or non-finite saliency (names the vertex). Complexity O(V + T), allocation O(clusters).
+// Serial; pure (concurrent calls are safe).
 template <class M>
 result<cluster_table> compute_cluster_attributes(const M& m, std::span<const double> saliency,
                                                  std::span<const std::uint32_t> cluster, std::uint32_t cluster_count) {
@@ -116,7 +117,7 @@ struct view_importance {
 };
 
 // A_est and I_est of every cluster for a camera at camera_position. Errors: a non-finite
-// camera position (bad_parameter). Complexity O(clusters); allocation: the result.
+// camera position (bad_parameter). Complexity O(clusters); allocation: the result. Pure, thread-safe.
 inline result<view_importance> estimate_view_importance(const cluster_table& table, const glm::dvec3& camera_position) {
   if (!std::isfinite(camera_position.x) || !std::isfinite(camera_position.y) || !std::isfinite(camera_position.z))
     return make_error(errc::bad_parameter, no_element, "camera position is not finite");
@@ -154,6 +155,7 @@ inline result<view_importance> estimate_view_importance(const cluster_table& tab
 // capacity[k] = the most contractions cluster k allows. Errors: sizes differ (bad_size),
 // lambda_perc outside (0, 1] or a non-finite priority (bad_parameter). The sum of the result is
 // min(global_target, Σ capacity). Complexity O(C log C + C · passes), passes <= 1/lambda_perc + C.
+// Allocation: the result and a sorted order (O(C)). Pure, thread-safe.
 inline result<std::vector<std::uint64_t>> distribute_contractions(std::span<const double> priority,
                                                                   std::span<const std::uint64_t> capacity,
                                                                   std::uint64_t global_target, double lambda_perc = 0.02) {

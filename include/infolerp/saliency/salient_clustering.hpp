@@ -271,6 +271,7 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
 // reused by every round). Serial. bunny00 (75k faces), C = 10, 16 rounds: ~0.7 s on a loaded
 // 2-core EPYC VM (was 1.05 s before the renumbering and the lighter queue entries).
+// Pure: concurrent calls on the same mesh are safe.
 template <class M>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,
                                             const salient_clustering_options& opt = {}) {
@@ -358,6 +359,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
 // mean over the vertices of cluster c's triangles (each vertex once); the first term is 0 when
 // max S_c = min S_c. Preconditions: saliency has one value per vertex, cluster one id <
 // cluster_count per triangle, indices valid. Complexity O(V + T); allocation O(T + V + clusters).
+// Serial; pure.
 template <class M>
 std::vector<double> cluster_localized_saliency(const M& m, std::span<const double> saliency,
                                                std::span<const std::uint32_t> cluster, std::uint32_t cluster_count) {

@@ -74,6 +74,7 @@ class pass_controller {
     return c;
   }
 
+  // Accessors: O(1), no allocation.
   // Pass count for the next frame, in [1, max_passes]; 1 is plain per-pixel evaluation.
   [[nodiscard]] std::uint32_t passes() const noexcept { return passes_; }
   [[nodiscard]] const pass_controller_options& options() const noexcept { return options_; }

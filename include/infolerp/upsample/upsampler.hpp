@@ -234,6 +234,7 @@ class upsampler {
     return render(src, out, serial_executor{});
   }
 
+  // Accessors: O(1), no allocation; spans stay valid until the next resize().
   [[nodiscard]] std::uint32_t width() const noexcept { return width_; }
   [[nodiscard]] std::uint32_t height() const noexcept { return height_; }
   [[nodiscard]] std::uint32_t passes() const noexcept { return options_.passes; }

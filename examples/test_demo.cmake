@@ -1,0 +1,102 @@
+# ctest driver for infolerp_demo (examples/CMakeLists.txt):
+#   MODE=errors  bad options and bad files: each gives exit code 1 or 2 (not a signal) and exactly
+#                one line on stderr that says what is wrong
+#   MODE=run     a small run (65x65, AO 4, soft 2, --threads 2, then --passes auto at 33x33):
+#                exit 0 and every output file written
+# Arguments: -DDEMO=<infolerp_demo> -DWORK_DIR=<scratch dir> -DMODE=errors|run
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+
+function(expect_error expected_rc pattern)
+  execute_process(COMMAND ${DEMO} ${ARGN} --size 17 17 --ao 1 --soft 1 --out ${WORK_DIR}/out
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  string(REGEX MATCHALL "\n" lines "${err}")
+  list(LENGTH lines nlines)
+  if(NOT rc STREQUAL "${expected_rc}" OR NOT nlines EQUAL 1 OR NOT err MATCHES "^infolerp_demo: .*${pattern}")
+    message(FATAL_ERROR "infolerp_demo ${ARGN}\n  expected exit ${expected_rc} and one stderr line matching "
+                        "'${pattern}'\n  got exit '${rc}', ${nlines} line(s):\n${err}")
+  endif()
+  message(STATUS "ok (${rc}): ${ARGN} -> ${err}")
+endfunction()
+
+function(expect_files)
+  foreach(f IN LISTS ARGN)
+    if(NOT EXISTS ${f})
+      message(FATAL_ERROR "missing output ${f}")
+    endif()
+    file(SIZE ${f} size)
+    if(size EQUAL 0)
+      message(FATAL_ERROR "empty output ${f}")
+    endif()
+  endforeach()
+endfunction()
+
+if(MODE STREQUAL "errors")
+  expect_error(2 "unknown option '--bogus'" --bogus)
+  expect_error(2 "unknown option 'extra'" extra)
+  expect_error(2 "--size needs two integers" --size 0 10)
+  expect_error(2 "--size needs two integers" --size 10)
+  expect_error(2 "--passes needs K" --passes 0)
+  expect_error(2 "--passes needs K" --passes 17)
+  expect_error(2 "--passes needs K" --passes fast)
+  expect_error(2 "--threads needs an integer" --threads 0)
+  expect_error(2 "--threshold: unknown channel 'colour'" --threshold colour=0.5)
+  expect_error(2 "--threshold: visibility value '1.5' is not a number in \\[0, 1\\]" --threshold visibility=1.5)
+  expect_error(2 "--threshold: stretch value '-0.1'" --threshold stretch=-0.1)
+  expect_error(2 "--threshold: orientation value 'nan'" --threshold orientation=nan)
+  expect_error(2 "--threshold needs CHANNEL=VALUE" --threshold visibility)
+  expect_error(2 "--mesh needs a file name" --mesh)
+
+  # Files: missing, not a mesh, truncated, an index out of range, a NaN coordinate.
+  expect_error(1 "cannot open mesh '${WORK_DIR}/missing.off'" --mesh ${WORK_DIR}/missing.off)
+  expect_error(1 "cannot load mesh '${WORK_DIR}/missing.obj'" --mesh ${WORK_DIR}/missing.obj)
+  file(WRITE ${WORK_DIR}/garbage.off "this is not a mesh\n")
+  expect_error(1 "not an OFF file" --mesh ${WORK_DIR}/garbage.off)
+  file(WRITE ${WORK_DIR}/truncated.off "OFF\n4 2 0\n0 0 0\n1 0 0\n")
+  expect_error(1 "line 4: truncated vertex list" --mesh ${WORK_DIR}/truncated.off)
+  file(WRITE ${WORK_DIR}/index.off "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 2 1 9\n")
+  expect_error(1 "triangle 1 corner 2: vertex index 9 out of range \\(vertex count 4\\)" --mesh ${WORK_DIR}/index.off)
+  file(WRITE ${WORK_DIR}/nan.off "OFF\n4 2 0\n0 0 0\n1 0 0\nnan 1 0\n1 1 0\n3 0 1 2\n3 2 1 3\n")
+  expect_error(1 "vertex 2: non-finite position" --mesh ${WORK_DIR}/nan.off)
+  file(WRITE ${WORK_DIR}/broken.obj "v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+  expect_error(1 "mesh '${WORK_DIR}/broken.obj'" --mesh ${WORK_DIR}/broken.obj)
+
+  # An output directory that cannot be created (a regular file is in the way).
+  file(WRITE ${WORK_DIR}/file "x")
+  execute_process(COMMAND ${DEMO} --size 17 17 --out ${WORK_DIR}/file/out RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc STREQUAL "1" OR NOT err MATCHES "^infolerp_demo: cannot create output directory")
+    message(FATAL_ERROR "unwritable --out: exit '${rc}': ${err}")
+  endif()
+
+  execute_process(COMMAND ${DEMO} --help RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "--passes K\\|auto")
+    message(FATAL_ERROR "--help: exit '${rc}': ${out}")
+  endif()
+elseif(MODE STREQUAL "run")
+  execute_process(COMMAND ${DEMO} --size 65 65 --ao 4 --soft 2 --threads 2 --passes 3 --threshold visibility=0.48
+                          --out ${WORK_DIR}/out RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "small run: exit '${rc}'\n${out}\n${err}")
+  endif()
+  set(files reference.png saliency.png ibuffer.png rie.png error.png summary.csv tradeoff.png)
+  list(TRANSFORM files PREPEND ${WORK_DIR}/out/)
+  expect_files(${files})
+  file(STRINGS ${WORK_DIR}/out/summary.csv rows)
+  list(GET rows 0 header)
+  list(LENGTH rows nrows)
+  if(NOT header MATCHES "^method,seconds,speedup,psnr_db,ssim" OR nrows LESS 6 OR NOT "${rows}" MATCHES "reference,.*ibuffer-3,")
+    message(FATAL_ERROR "summary.csv:\n${rows}")
+  endif()
+  foreach(f IN ITEMS "reference.png" "summary.csv" "tradeoff.png")
+    if(NOT out MATCHES "wrote [^\n]*${f}")
+      message(FATAL_ERROR "the demo did not say where ${f} went:\n${out}")
+    endif()
+  endforeach()
+
+  execute_process(COMMAND ${DEMO} --size 33 33 --ao 2 --soft 1 --passes auto --out ${WORK_DIR}/auto
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "ibuffer-auto")
+    message(FATAL_ERROR "--passes auto: exit '${rc}'\n${out}\n${err}")
+  endif()
+  expect_files(${WORK_DIR}/auto/ibuffer.png ${WORK_DIR}/auto/summary.csv)
+endif()

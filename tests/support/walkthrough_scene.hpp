@@ -1,0 +1,42 @@
+#pragma once
+// The procedural walkthrough scene of the refinement experiment (Oliveira, Santos, Proença, §5,
+// §6): a street with a portico (six columns under a roof slab), a long wall and a tall
+// temple-like column on a coarse ground of large triangles (10 m each), lit by a low sun so that
+// hard shadows cross triangles without touching their vertices. Used by infolerp_pareto refine
+// and examples/refine_wireframe.cpp.
+#include <cstdint>
+#include <memory>
+#include <vector>
+#include <glm/vec3.hpp>
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/tracer.hpp"
+#include "infolerp/mesh/adaptors.hpp"
+#include "infolerp/refine/progressive_driver.hpp"
+#include "support/embree_tracer.hpp"
+
+namespace infolerp::support {
+
+struct walkthrough_scene {
+  indexed_mesh mesh;              // one mesh: ground, columns, roof, wall, temple column
+  std::vector<glm::vec3> albedo;  // per triangle
+  std::vector<glm::vec3> normal;  // per triangle, unit
+  glm::vec3 to_sun{0.0f, 0.0f, 1.0f};  // unit, toward the sun
+
+  // Traced with Embree 3; committed by make_walkthrough_scene().
+  std::unique_ptr<embree_device> device;
+  std::unique_ptr<embree_scene> tracer;
+  hit intersect(const ray& r) const { return tracer->intersect(r); }
+  bool occluded(const ray& r) const { return tracer->occluded(r); }
+
+  // Lambert with a hard sun shadow (one ray) and a constant sky term, at point p of triangle t.
+  // Thread-safe; sets flush-to-zero on the calling thread (embree_tracer.hpp).
+  glm::vec3 shade(glm::vec3 p, std::uint32_t t) const;
+};
+
+// Builds the scene and commits its tracer. Errors: Embree rejects the mesh.
+result<walkthrough_scene> make_walkthrough_scene();
+
+// The street view of the experiment: from the end of the street toward the portico.
+pinhole_camera walkthrough_camera(std::uint32_t width, std::uint32_t height);
+
+}  // namespace infolerp::support
