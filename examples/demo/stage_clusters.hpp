@@ -6,6 +6,7 @@
 // out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage.
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 #include <glm/vec3.hpp>
@@ -28,16 +29,23 @@ inline glm::vec3 cluster_colour(std::uint32_t k) {
   return glm::vec3(rgb + mn);
 }
 
-// Clusters one mesh with any tracer; returns the clustering (ids per triangle).
+// Clusters one mesh with any tracer; returns the clustering (ids per triangle). thresholds maps
+// a channel name (visibility, orientation, stretch) to its Th; missing ones take the defaults.
 template <class Tracer, class Exec>
-result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& tracer, Exec&& exec, const std::string& label) {
+result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& tracer, Exec&& exec, const std::string& label,
+                                       const std::map<std::string, float>& thresholds = {}) {
+  const auto th = [&](const char* channel, double fallback) {
+    const auto it = thresholds.find(channel);
+    return it == thresholds.end() ? fallback : static_cast<double>(it->second);
+  };
   progress_bar bar("visibility " + label);
   return cluster_mesh(mesh, tracer, exec, cluster_options{},
-                      visibility_channel{.threshold = 0.48, .viewpoints = 64,
+                      visibility_channel{.threshold = th("visibility", 0.48), .viewpoints = 64,
                                          .progress = [&](std::size_t done, std::size_t total) {
                                            bar(static_cast<int>(done), static_cast<int>(total));
                                          }},
-                      orientation_channel{.threshold = 0.05, .bins = 256}, stretch_channel{.threshold = 0.1, .bins = 256});
+                      orientation_channel{.threshold = th("orientation", 0.05), .bins = 256},
+                      stretch_channel{.threshold = th("stretch", 0.1), .bins = 256});
 }
 
 inline bool stage_clusters(const demo_context& ctx, support::scene_clustering& out) {
@@ -48,9 +56,9 @@ inline bool stage_clusters(const demo_context& ctx, support::scene_clustering& o
     std::vector<std::uint32_t> remap;
     const indexed_mesh welded = support::weld_positions(object.mesh, remap);  // seams joined; same triangles
 #ifdef _OPENMP
-    auto r = cluster_object(welded, ctx.scene.tracer, openmp_executor{ctx.options.threads}, object.name);
+    auto r = cluster_object(welded, ctx.scene.tracer, openmp_executor{ctx.options.threads}, object.name, ctx.options.thresholds);
 #else
-    auto r = cluster_object(welded, ctx.scene.tracer, serial_executor{}, object.name);
+    auto r = cluster_object(welded, ctx.scene.tracer, serial_executor{}, object.name, ctx.options.thresholds);
 #endif
     if (!r) {
       report(r.error());
