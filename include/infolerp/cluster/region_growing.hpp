@@ -108,25 +108,9 @@ inline void canonical_numbering(std::vector<std::uint32_t>& label, std::vector<s
 
 // One cluster per connected component, seeded at its smallest element.
 inline void component_clusters(const element_graph& g, region_growing_result& r) {
-  const std::size_t m = g.size();
-  r.cluster_of.assign(m, invalid_id);
-  std::vector<std::uint32_t> stack;
-  for (std::uint32_t e = 0; e < m; ++e) {
-    if (r.cluster_of[e] != invalid_id) continue;
-    const auto k = static_cast<std::uint32_t>(r.seeds.size());
-    r.seeds.push_back(e);
-    r.cluster_of[e] = k;
-    stack.push_back(e);
-    while (!stack.empty()) {
-      const std::uint32_t t = stack.back();
-      stack.pop_back();
-      for (std::uint32_t n : g.neighbours_of(t))
-        if (r.cluster_of[n] == invalid_id) {
-          r.cluster_of[n] = k;
-          stack.push_back(n);
-        }
-    }
-  }
+  r.cluster_of.assign(g.size(), invalid_id);
+  label_unlabelled_components(
+      r.cluster_of, 0, [&](std::uint32_t e) { return g.neighbours_of(e); }, [&](std::uint32_t e) { r.seeds.push_back(e); });
 }
 
 }  // namespace detail

@@ -136,33 +136,46 @@ result<mesh_topology> build_topology(const M& m) {
   return topo;
 }
 
+// Gives every element whose label is invalid_id the label of its connected component among the
+// still-unlabelled elements, numbering new components next, next+1, ... in order of their
+// smallest element; on_new(first_element) is called once per new component. neighbours_of(e)
+// returns the element's neighbours (any range of uint32). Returns the next unused label.
+// Complexity O(elements + adjacency); allocation: a stack of at most the elements. Deterministic.
+template <class Neighbours, class OnNew>
+std::uint32_t label_unlabelled_components(std::span<std::uint32_t> label, std::uint32_t next,
+                                          Neighbours&& neighbours_of, OnNew&& on_new) {
+  std::vector<std::uint32_t> stack;
+  for (std::size_t seed = 0; seed < label.size(); ++seed) {
+    if (label[seed] != invalid_id) continue;
+    const std::uint32_t id = next++;
+    label[seed] = id;
+    on_new(static_cast<std::uint32_t>(seed));
+    stack.push_back(static_cast<std::uint32_t>(seed));
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      for (std::uint32_t n : neighbours_of(t))
+        if (label[n] == invalid_id) {
+          label[n] = id;
+          stack.push_back(n);
+        }
+    }
+  }
+  return next;
+}
+
 // Connected components of the dual graph (triangles joined across shared edges).
 struct components {
   std::vector<std::uint32_t> label;  // per triangle, 0..count-1, numbered by smallest triangle
   std::uint32_t count = 0;
 };
 
-// Complexity O(T + neighbours), allocation O(T). Deterministic; thread-safe (reads topo only).
+// Complexity O(T + neighbours), allocation O(T). Deterministic.
 inline components connected_components(const mesh_topology& topo) {
-  const std::size_t nt = topo.triangle_count();
   components out;
-  out.label.assign(nt, invalid_id);
-  std::vector<std::uint32_t> stack;
-  for (std::size_t seed = 0; seed < nt; ++seed) {
-    if (out.label[seed] != invalid_id) continue;
-    const std::uint32_t id = out.count++;
-    out.label[seed] = id;
-    stack.push_back(static_cast<std::uint32_t>(seed));
-    while (!stack.empty()) {
-      const std::uint32_t t = stack.back();
-      stack.pop_back();
-      for (std::uint32_t n : topo.neighbours_of(t))
-        if (out.label[n] == invalid_id) {
-          out.label[n] = id;
-          stack.push_back(n);
-        }
-    }
-  }
+  out.label.assign(topo.triangle_count(), invalid_id);
+  out.count = label_unlabelled_components(
+      out.label, 0, [&](std::uint32_t t) { return topo.neighbours_of(t); }, [](std::uint32_t) {});
   return out;
 }
 

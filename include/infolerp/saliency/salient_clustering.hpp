@@ -337,20 +337,8 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
   out.cluster.resize(nt);
   for (std::size_t i = 0; i < nt; ++i) out.cluster[fd.original[i]] = label[i];
   // Faces no seed reached (other components): one extra cluster per unreached component.
-  out.count = opt.clusters;
-  std::vector<std::uint32_t> stack;
-  for (std::size_t f = 0; f < nt; ++f) {
-    if (out.cluster[f] != invalid_id) continue;
-    const std::uint32_t id = out.count++;
-    out.cluster[f] = id;
-    stack.push_back(static_cast<std::uint32_t>(f));
-    while (!stack.empty()) {
-      const std::uint32_t g = stack.back();
-      stack.pop_back();
-      for (std::uint32_t h : topo->neighbours_of(g))
-        if (out.cluster[h] == invalid_id) out.cluster[h] = id, stack.push_back(h);
-    }
-  }
+  out.count = label_unlabelled_components(
+      out.cluster, opt.clusters, [&](std::uint32_t f) { return topo->neighbours_of(f); }, [](std::uint32_t) {});
   return out;
 }
 
