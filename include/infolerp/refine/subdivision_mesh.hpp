@@ -269,11 +269,14 @@ class subdivision_mesh {
     select(t, propagation_depth);
     return {};
   }
-  // Splits each selected triangle in order (see split). Errors: the first id out of range
-  // (the ones before it are split).
+  // Splits each selected triangle in order (see split). Errors: the first id out of range;
+  // then nothing is split (all ids are checked before the mesh changes).
   status split(std::span<const std::uint32_t> selected) {
-    for (std::uint32_t t : selected)
-      if (auto st = split(t); !st) return st;
+    for (std::size_t i = 0; i < selected.size(); ++i)
+      if (selected[i] >= tris_.size())
+        return make_error(errc::index_out_of_range, selected[i], "selection ", i, ": triangle ", selected[i],
+                          " out of range (", tris_.size(), " triangles)");
+    for (std::uint32_t t : selected) select(t, options_.propagation_depth);
     return {};
   }
 
