@@ -188,7 +188,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& g, const 
     std::array<std::pair<std::uint32_t, std::uint32_t>, 14> ranges{};
     std::size_t nr = 0;
     for (const auto& o : forward) {
-      const long long nx = cx + o[0], ny = static_cast<long long>(cy) + o[1], nz = static_cast<long long>(cz) + o[2];
+      const long long nx = static_cast<long long>(cx) + o[0], ny = static_cast<long long>(cy) + o[1], nz = static_cast<long long>(cz) + o[2];
       if (nx >= g.n[0] || ny < 0 || ny >= g.n[1] || nz < 0 || nz >= g.n[2]) continue;
       const std::uint32_t d = g.cell_index(static_cast<std::uint32_t>(nx), static_cast<std::uint32_t>(ny),
                                            static_cast<std::uint32_t>(nz));
