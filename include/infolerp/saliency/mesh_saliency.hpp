@@ -333,7 +333,8 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5 (bad_parameter); a mesh
+// scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5, a σ whose square is not a
+// normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a mesh
 // whose bounding box has zero diagonal (degenerate_triangle).
 // Complexity, exact: O(V + T + pairs within 2σ_max · distinct σs); approximate: O(V·σs·k) with
 // k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (16 doubles per
@@ -370,7 +371,15 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   mult.erase(std::unique(mult.begin(), mult.end()), mult.end());
   if (mult.size() > 32) return make_error(errc::bad_parameter, no_element, "at most 16 saliency scales are supported");
   std::vector<double> sigma(mult.size());
-  for (std::size_t u = 0; u < mult.size(); ++u) sigma[u] = mult[u] * out.epsilon;
+  for (std::size_t u = 0; u < mult.size(); ++u) {
+    sigma[u] = mult[u] * out.epsilon;
+    // The Gaussian divides by 2σ²: a σ² that underflows (or overflows) would turn the weights
+    // of coincident vertices into NaN (0 · Inf).
+    const double s2 = sigma[u] * sigma[u];
+    if (!(s2 >= std::numeric_limits<double>::min()) || !std::isfinite(s2))
+      return make_error(errc::bad_parameter, no_element, "saliency sigma ", sigma[u],
+                        " (scale x epsilon x bounding-box diagonal) is outside double precision");
+  }
   auto index_of = [&](double s) {
     return static_cast<std::size_t>(std::lower_bound(mult.begin(), mult.end(), s) - mult.begin());
   };
