@@ -422,6 +422,10 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   check_cell("empty option list", "compute_saliency", sal({.scales = {}}), {errc::bad_parameter, "at least one scale"});
   check_cell("threshold NaN", "compute_saliency", sal({.scales = {2.0, nan_d}}), {errc::bad_parameter, "scale 1"});
   check_cell("threshold below 0", "compute_saliency", sal({.scales = {-2.0}}), {errc::bad_parameter, "scale 0"});
+  // A σ whose square underflows made the Gaussian weights of coincident vertices NaN (fuzzer).
+  check_cell("parameter underflows", "compute_saliency", sal({.scales = {1e-160}}), {errc::bad_parameter, "saliency sigma"});
+  check_cell("parameter underflows", "compute_saliency(approx)",
+             sal({.scales = {1e-160}, .method = infolerp::saliency_method::approximate}), {errc::bad_parameter, "saliency sigma"});
   check_cell("threshold below 0", "compute_saliency(approx)",
              sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = 0.1}),
              {errc::bad_parameter, "approx_cells_per_sigma"});
