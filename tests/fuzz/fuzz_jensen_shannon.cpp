@@ -43,8 +43,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::reader r{data, size};
   const std::uint8_t mode = r.u8();
   const double w = r.unit();
-  const std::size_t bins = r.u16() % 4096;
-  const std::size_t bins_q = (mode & 1) ? bins : r.u16() % 4096;  // mismatched sizes sometimes
+  const std::size_t bins = r.u16() % 2048;
+  const std::size_t bins_q = (mode & 1) ? bins : r.u16() % 2048;  // mismatched sizes sometimes
   std::vector<double> p(bins), q(bins_q);
   for (auto& x : p) x = entry(r);
   for (auto& x : q) x = entry(r);

@@ -42,7 +42,7 @@ void render_and_check(up_t& up, const source& src) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   fuzz::reader r{data, size};
-  const std::uint32_t w = r.u16() % 320, h = r.u16() % 240;
+  const std::uint32_t w = r.u16() % 160, h = r.u16() % 120;
   infolerp::upsampler_options o;
   o.passes = r.u8() % 18;
   o.max_passes = r.u8() % 18;
@@ -64,7 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!up.ok()) return 0;
   render_and_check(*up, src);
 
-  for (int op = 0; op < 6 && !r.empty(); ++op) {
+  for (int op = 0; op < 4 && !r.empty(); ++op) {
     switch (r.u8() % 3) {
       case 0: {
         const std::uint32_t passes = r.u8() % 18, before = up->passes();
@@ -74,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 1: {
-        const std::uint32_t nw = r.u16() % 320, nh = r.u16() % 240, ow = up->width(), oh = up->height();
+        const std::uint32_t nw = r.u16() % 160, nh = r.u16() % 120, ow = up->width(), oh = up->height();
         const infolerp::status st = up->resize(nw, nh);
         fuzz::check_error(st);
         FUZZ_CHECK(st.ok() ? (up->width() == nw && up->height() == nh) : (up->width() == ow && up->height() == oh));

@@ -71,7 +71,7 @@ ops = bytes([0x82, 3, 0, 1, 0x83, 0, 0x84, 3, 0, 0, 1, 0, 2, 0, 0x80, 1, 50, 80,
              0x82, 7, 0, 0, 0x02, 2, 1, 0, 0xE8, 0x03])
 write("fuzz_subdivision", "grid_ops", bytes([1 | (2 << 1), 127, 1]) + ops)
 write("fuzz_subdivision", "octahedron_ops", bytes([0, 64, 2]) + mesh(OCTA_V, OCTA_T) + ops)
-write("fuzz_subdivision", "deep_chain", bytes([1, 127, 1]) + bytes([0x83, 0] * 120))
+write("fuzz_subdivision", "deep_chain", bytes([1, 127, 1]) + bytes([0x83, 3] * 300) + bytes([0x80, 0, 20, 30]))
 
 # fuzz_upsampler: [w u16][h u16][passes][max passes][rows][flags][cell][id count][ids] then ops, controller
 up = struct.pack("<HH", 61, 47) + bytes([4, 4, 2, 3, 6, 4, 0, 1, 255, 2])
