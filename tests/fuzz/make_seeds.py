@@ -66,7 +66,7 @@ write("fuzz_saliency", "octahedron_one_scale", bytes([0, 40, 1, 127, 100, 2, 9])
 
 # fuzz_subdivision: [flags][bisect][depth][mesh unless flags & 1] then operations
 # op code % 5: 0 split id (u16, depth u8), 1 newest (back u8), 2 selection (count u8, u16 ids),
-# 3 locate (original u8, u, v), 4 tessellate (limit, max level); bit 7 also checks conformity.
+# 3 locate (original u8, u, v), 4 tessellate (limit, max level); bits 5-7 all set also check conformity.
 ops = bytes([0x82, 3, 0, 1, 0x83, 0, 0x84, 3, 0, 0, 1, 0, 2, 0, 0x80, 1, 50, 80, 0x81, 40, 3, 0x83, 0, 0x83, 0,
              0x82, 7, 0, 0, 0x02, 2, 1, 0, 0xE8, 0x03])
 write("fuzz_subdivision", "grid_ops", bytes([1 | (2 << 1), 127, 1]) + ops)
