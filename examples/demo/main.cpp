@@ -9,6 +9,7 @@
 #include <string_view>
 #include <system_error>
 #include "demo.hpp"
+#include "stage_clusters.hpp"
 #include "stage_saliency.hpp"
 #include "stage_upsample.hpp"
 
@@ -125,7 +126,9 @@ int main(int argc, char** argv) {
   const support::reference_shader shader(*scene, options->shader);
   demo::demo_context ctx{*options, *scene, shader, {}, {}};
   if (!stage_reference(ctx)) return 1;
+  support::scene_clustering clusters;
+  if (!demo::stage_clusters(ctx, clusters)) return 1;
   if (!demo::stage_saliency(ctx)) return 1;
-  if (!demo::stage_upsample(ctx)) return 1;
+  if (!demo::stage_upsample(ctx, &clusters)) return 1;
   return 0;
 }

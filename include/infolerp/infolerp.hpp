@@ -1,7 +1,15 @@
 #pragma once
 // Umbrella header, for convenience only: every infolerp header compiles on its own.
+#include "infolerp/cluster/boundary_smoothing.hpp"
+#include "infolerp/cluster/channel.hpp"
+#include "infolerp/cluster/cluster_mesh.hpp"
+#include "infolerp/cluster/orientation_channel.hpp"
+#include "infolerp/cluster/region_growing.hpp"
+#include "infolerp/cluster/stretch_channel.hpp"
+#include "infolerp/cluster/visibility_channel.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/info/entropy.hpp"

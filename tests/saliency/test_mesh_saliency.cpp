@@ -61,9 +61,9 @@ reference brute_force(const infolerp::indexed_mesh& m, const infolerp::saliency_
     const double scale = 1.0 / std::max(mx, opt.flat_level_threshold * mean_abs);
     const std::size_t global = static_cast<std::size_t>(std::max_element(level.begin(), level.end()) - level.begin());
     std::vector<bool> is_max(n, true);
-    for (const auto& e : topo.edges) {
-      if (level[e.x] <= level[e.y]) is_max[e.x] = false;
-      if (level[e.y] <= level[e.x]) is_max[e.y] = false;
+    for (const auto& e : topo.edges) {  // local maxima: above every 1-ring neighbour by > 1e-12 max
+      if (level[e.x] <= level[e.y] + 1e-12 * mx) is_max[e.x] = false;
+      if (level[e.y] <= level[e.x] + 1e-12 * mx) is_max[e.y] = false;
     }
     double sum = 0.0;
     int count = 0;

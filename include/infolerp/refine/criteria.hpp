@@ -23,6 +23,7 @@
 #include <queue>
 #include <span>
 #include <vector>
+#include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/refine/nld.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
@@ -79,18 +80,12 @@ struct refinement_frame {
 
 // What a criterion keeps between batches (RND's random stream and point count).
 struct criterion_state {
-  std::uint64_t rng = 0;
+  splitmix64 rng;
   std::uint64_t points_drawn = 0;
   bool exhausted = false;  // RND: point budget used up
 };
 
 namespace detail {
-inline std::uint64_t splitmix64(std::uint64_t& s) noexcept {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
 inline float leaf_nld(const refinement_frame& f, std::uint32_t t) {
   const glm::uvec3 v = f.mesh->triangle(t).vertices;
   return nld(f.vertex_luminance[v.x], f.vertex_luminance[v.y], f.vertex_luminance[v.z], f.l_max);
@@ -183,7 +178,7 @@ inline void select_rnd(const refinement_frame& f, const criteria_options& o, cri
       return;
     }
     ++st.points_drawn;
-    const std::uint64_t p = detail::splitmix64(st.rng) % pixels;
+    const std::uint64_t p = st.rng.uniform(pixels);
     const std::uint32_t leaf = f.pixel_leaf[p];
     if (leaf == invalid_id || float(f.leaf_pixels[leaf]) < o.min_pixels) continue;
     if (std::find(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), leaf) == out.end()) out.push_back(leaf);

@@ -111,7 +111,7 @@ class progressive_refiner {
     progressive_refiner r;
     r.mesh_ = std::move(mesh);
     r.options_ = options;
-    r.state_.rng = options.criteria.seed;
+    r.state_.rng = splitmix64{options.criteria.seed};
     return r;
   }
 

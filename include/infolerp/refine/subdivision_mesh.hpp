@@ -43,6 +43,7 @@
 #include <glm/vec4.hpp>
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
+#include "infolerp/mesh/validate.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 
 namespace infolerp {
@@ -195,42 +196,28 @@ class subdivision_mesh {
     static_assert(check_mesh<M>());
     if (!(options.bisect_ratio >= 0.0f))
       return make_error(errc::bad_parameter, no_element, "bisect_ratio ", options.bisect_ratio, " must be >= 0");
+    // Empty mesh, index range, NaN/Inf, repeated index, zero area, non-manifold edge.
+    if (auto valid = validate_mesh(m); !valid) return valid;
     const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
-    if (nt == 0) return make_error(errc::empty_input, no_element, "mesh has no triangles");
     if (nv >= invalid_id / 2 || nt >= invalid_id / 8)
       return make_error(errc::unsupported, no_element, "mesh too large for 32-bit subdivision ids");
     subdivision_mesh s;
     s.options_ = options;
     s.positions_.resize(nv);
     s.vertex_source_.assign(nv, invalid_id);
-    for (std::size_t v = 0; v < nv; ++v) {
-      const glm::vec3 p = mesh_position(m, v);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        return make_error(errc::non_finite, v, "vertex ", v, ": non-finite position");
-      s.positions_[v] = p;
-    }
+    for (std::size_t v = 0; v < nv; ++v) s.positions_[v] = mesh_position(m, v);
     s.tris_.resize(nt);
     s.edges_.reserve(3 * nt / 2 + 3);
     for (std::size_t t = 0; t < nt; ++t) {
       const glm::uvec3 tri = mesh_triangle(m, t);
-      for (int c = 0; c < 3; ++c)
-        if (tri[c] >= nv)
-          return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
-                            " out of range (vertex count ", nv, ")");
-      if (tri.x == tri.y || tri.y == tri.z || tri.z == tri.x)
-        return make_error(errc::degenerate_triangle, t, "triangle ", t, ": repeated vertex index");
-      const glm::dvec3 p0(s.positions_[tri.x]), p1(s.positions_[tri.y]), p2(s.positions_[tri.z]);
-      if (!(glm::length(glm::cross(p1 - p0, p2 - p0)) > 0.0))
-        return make_error(errc::degenerate_triangle, t, "triangle ", t, ": zero area");
       const auto id = static_cast<std::uint32_t>(t);
       s.tris_[t].vertices = tri;
       s.tris_[t].original = id;
       for (int c = 0; c < 3; ++c) {
         if (s.vertex_source_[tri[c]] == invalid_id) s.vertex_source_[tri[c]] = id;
         auto& e = s.edges_.get(tri[c], tri[(c + 1) % 3]);
-        if (!detail::edge_table::add_face(e, id))
-          return make_error(errc::non_manifold_edge, t, "triangle ", t, ": edge (", tri[c], ", ", tri[(c + 1) % 3],
-                            ") is shared by more than two triangles");
+        [[maybe_unused]] const bool manifold = detail::edge_table::add_face(e, id);
+        INFOLERP_ASSERT(manifold && "validate_mesh rejects non-manifold edges");
       }
     }
     s.original_count_ = nt;

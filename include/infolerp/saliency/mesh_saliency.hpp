@@ -16,20 +16,30 @@
 //      noise stays near zero instead of becoming a full-range map);
 //   2. M = the scaled maximum; m̄ = mean of the scaled values at local maxima other than the
 //      global one (the first vertex attaining M), m̄ = 0 when there is none. A local maximum is a
-//      vertex whose value is strictly greater than at each 1-ring neighbour (vertices sharing an
-//      edge), so plateaus (e.g. zero saliency on a flat region) are not maxima;
+//      vertex whose value exceeds the value at each 1-ring neighbour (vertices sharing an edge)
+//      by more than 1e-12 · max_v S_i, so plateaus (e.g. zero saliency on a flat region) are not
+//      maxima, and neither are mathematical ties that rounding splits (a symmetric mesh has many:
+//      with a strict comparison, two computations that agree to 1e-14 gave saliencies 1% apart);
 //   3. N(S_i) = scaled S_i · (M − m̄)².
 //
-// Exact mode: vertices are sorted into a uniform grid with cells at least 2σ_max wide; each
-// pair of vertices within 2σ_max is visited once (same cell, or one of 13 forward neighbour
-// cells) and adds its Gaussian weights to both ends for every distinct σ whose ball holds it
-// (σ_i and 2σ_i: 8 distinct values for the default scales), all in one pass. Memory O(V·σs):
-// per vertex and distinct σ a numerator and denominator; pairs are never stored.
-// Determinism: cells are coloured (x mod 2, y mod 3, z mod 3); cells of one colour write to
-// disjoint vertex sets, and each colour runs as one parallel_for. Every accumulator therefore
-// receives its terms in a fixed order: identical bits for any executor and thread count.
-// The Gaussian uses a polynomial exp valid on [−2, 0] (the only range the ball cutoff produces),
-// relative error below 1e-15.
+// Exact mode: vertices are sorted into the columns of an xy grid (columns 2σ_max/3 wide), by z
+// inside a column, so the candidates of a vertex are, per nearby column, one contiguous z-run
+// (binary search). Every vertex gathers its own ball sums over its candidates for all distinct
+// σ (σ_i and 2σ_i: 8 values for the default scales) in one pass, 8 candidates at a time with
+// vector code; σ run from the largest down and stop at the first ball that holds none of the 8.
+// Only σ whose double 2σ is not in the set need an exp (3 of the 8 by default): w_σ = w_2σ⁴.
+// Memory O(V·σs); pairs are never stored. Each pair is evaluated from both ends (twice the
+// arithmetic of visiting it once) so that vertices are independent: no write conflicts, and
+// each vertex sums its terms in an order fixed by the data (8 lane sums, added pairwise), so the
+// result has identical bits for any executor and thread count.
+// Vector code: GCC/Clang vector extensions, 2 doubles (SSE2, NEON) in the portable build, plus
+// an AVX2+FMA version chosen at run time on x86-64 (define INFOLERP_NO_RUNTIME_DISPATCH to
+// always use the portable one); it differs only by FMA contraction (1e-16 relative per
+// operation). Other compilers get a plain 4-double struct. exp(−x) on [0, 2] (the only range
+// the ball cutoff produces) is a polynomial fit, relative error ~1e-16.
+// Measured (refined_elephant subdivided once, 177,852 vertices, ~586M pairs within 2σ_max,
+// 2-core AMD EPYC VM shared with other jobs): 6.3 s CPU with the AVX2 path (was 22.7 s), i.e.
+// ~3.2 s wall on 2 idle cores; refined_elephant (44k): 0.45 s CPU (AVX2), 0.98 s (portable).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
@@ -38,16 +48,32 @@
 // exp(−d²/2σ²)·(count, sum C) over representatives near its ball; a representative straddling
 // the 2σ edge counts with a linear ramp over ±1.5 × its spread (a single vertex keeps the hard
 // cutoff), which removes most of the in/out error of whole cells.
-// Measured relative L2 error of the final saliency against exact (default 3 cells per σ):
-// 0.5% on a 10k-vertex bumpy sphere (tests), but 6.2% on refined_elephant subdivided once
-// (9.6% at 1 cell/σ, 7.9% at 2), where Lee's local-maxima normalisation amplifies small level
-// errors. Note the normalisation is discontinuous: a 1e-15 change of a level can flip a local
-// maximum (exact ties on symmetric meshes), so even exact-to-rounding levels differ by ~0.3%.
+// Measured relative L2 error of the final saliency against exact: on a 10k-vertex bumpy sphere
+// (tests) 5.0% at 2 cells per σ, 2.0% at 3, 0.11% at 4 (the default); on refined_elephant
+// subdivided once 7.9% at 2, 6.2% at 3, 3.7% at 4, where Lee's local-maxima normalisation
+// amplifies small level errors. On that mesh this mode is no faster than exact (5.5, 8.9 and
+// 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes. Re-measured there
+// (BM_Saliency_Approx, 2 threads, load average 2.3–2.7): 9.6% at 1 cell per σ (1.96 s wall),
+// 7.9% at 2 (3.6 s), 6.2% at 3 (4.3 s), 3.7% at 4 (5.8 s), 2.8% at 5 (13.6 s), 1.45% at 6
+// (19.8 s); exact took 6.2 s wall in the same run. The issue's goal (0.1 s at 1%) is not met.
+// Lattice schemes tried instead (branch salapprox, issue 4) and not kept, because they fail the
+// 1% test on the bumpy sphere (lattice spacing h = σ / cells per σ, refined_elephant subdivided
+// once, error = relative L2 of the final saliency against exact, CPU time of the whole call):
+//   - splat–gather–slice: trilinear splat of (1, C), node-to-node ball-truncated Gaussian
+//     (σ_n² = σ² − h²/3), trilinear slice: 11.4% at 1 cell per σ (0.42 s CPU), 9.0% at 2
+//     (1.1 s), 8.8% at 4 (7.4 s), 7.2% at 6 (32 s); bumpy sphere 4.2% at 4.
+//   - exact ball averages at the lattice nodes, trilinear slice: 10.8% at 1 (0.63 s CPU), 9.0%
+//     at 2 (1.5 s), 8.3% at 3 (2.6 s), 7.5% at 4 (4.0 s), 6.4% at 5 (5.2 s), 5.1% at 6 (6.1 s,
+//     as slow as exact); bumpy sphere 8.8% at 4.
+// Both converge slowly because S_i = |G(σ) − G(2σ)| is a small difference of two averages
+// (worst level errors 14–33% on the bumpy sphere), and the hard 2σ cutoff (a step of e⁻² in the
+// kernel) is smeared by any lattice: its error is first order in h/σ.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -72,8 +98,8 @@ struct saliency_options {
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   saliency_method method = saliency_method::exact;  // exact or approximate
-  double approx_cells_per_sigma = 3.0;             // approximate mode: representative cells per σ (>= 0.5)
-  std::size_t grain = 1;                           // cells per parallel task (exact) ×256 vertices (approximate)
+  double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ (>= 0.5)
+  std::size_t grain = 1;                           // ×64 vertices (exact), ×256 vertices (approximate) per parallel task
 };
 
 struct mesh_saliency {
@@ -85,25 +111,36 @@ struct mesh_saliency {
 
 namespace detail {
 
-// exp(x) for x in [−2, 0]: Taylor polynomial of exp(x/8) (|x/8| ≤ 1/4, degree 11, truncation
-// < 2e-16) raised to the 8th power. Branch-free, relative error ~1e-15.
+#if defined(__GNUC__) || defined(__clang__)
+#define INFOLERP_SALIENCY_INLINE __attribute__((always_inline)) inline  // compiled into each ISA version
+#else
+#define INFOLERP_SALIENCY_INLINE inline
+#endif
+
+// x ← exp(−x) for x in [0, 2] (the only range the 2σ ball cutoff produces), for double or a
+// vector of doubles: q(x)⁴ with q the degree-10 Chebyshev fit of exp(−x/4) on [0, 2]. Relative
+// error ~1e-16 (fit) plus a few roundings; q(0) = 1 exactly. Branch-free; x > 2 gives finite or
+// infinite values that callers mask out. In place: vector arguments by value would trip GCC's
+// -Wpsabi note in the user's translation unit.
+template <class T>
+INFOLERP_SALIENCY_INLINE void exp_neg_inplace(T& x) {
+  // Estrin's scheme: 4 dependent multiply-adds instead of Horner's 10 (the kernel is latency-bound).
+  const T x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
+  const T p01 = x * -0.24999999999999944 + 1.0, p23 = x * -0.0026041666665787633 + 0.03124999999998875;
+  const T p45 = x * -8.138020007655508e-06 + 0.00016276041631414334;
+  const T p67 = x * -1.2109012825312624e-08 + 3.3908299377631024e-07;
+  const T p89 = x * -1.024918557153169e-11 + 3.77751130723742e-10;
+  const T p03 = x2 * p23 + p01, p47 = x2 * p67 + p45, p810 = x2 * 2.049410196605228e-13 + p89;
+  const T q = x8 * p810 + (x4 * p47 + p03);
+  const T q2 = q * q;
+  x = q2 * q2;
+}
+
+// exp(x) for x in [−2, 0].
 inline double exp_neg2(double x) {
-  const double y = x * 0.125;
-  double p = 1.0 / 39916800.0;
-  p = p * y + 1.0 / 3628800.0;
-  p = p * y + 1.0 / 362880.0;
-  p = p * y + 1.0 / 40320.0;
-  p = p * y + 1.0 / 5040.0;
-  p = p * y + 1.0 / 720.0;
-  p = p * y + 1.0 / 120.0;
-  p = p * y + 1.0 / 24.0;
-  p = p * y + 1.0 / 6.0;
-  p = p * y + 0.5;
-  p = p * y + 1.0;
-  p = p * y + 1.0;
-  p *= p;
-  p *= p;
-  return p * p;
+  x = -x;
+  exp_neg_inplace(x);
+  return x;
 }
 
 // Points (x, y, z, value, weight) sorted by the cell of a uniform grid, cells at least
@@ -164,83 +201,269 @@ inline point_grid make_point_grid(const std::vector<glm::dvec3>& pts, const std:
   return g;
 }
 
-// Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
-// points (weights are 1). Returns avg[u * P + k] for sorted point k. Needs grid cells >= 2σ_max.
-template <class E>
-std::vector<double> exact_gaussian_averages(E& exec, const point_grid& g, const std::vector<double>& sigma,
-                                            std::size_t grain) {
-  const std::size_t P = g.x.size(), L = sigma.size();
-  std::vector<double> r2(L), a(L);
-  for (std::size_t u = 0; u < L; ++u) r2[u] = 4.0 * sigma[u] * sigma[u], a[u] = 1.0 / (2.0 * sigma[u] * sigma[u]);
-  const double r2max = r2[L - 1];
-  // acc[k*2L + 2u] = numerator, +1 = denominator; the vertex itself contributes weight 1.
-  std::vector<double> acc(P * 2 * L);
-  for (std::size_t k = 0; k < P; ++k)
-    for (std::size_t u = 0; u < L; ++u) acc[k * 2 * L + 2 * u] = g.value[k], acc[k * 2 * L + 2 * u + 1] = 1.0;
+// Points sorted into columns of an xy grid, by z (then id) inside each column, so the points of
+// one column within a z interval are one contiguous run (found by binary search).
+struct column_grid {
+  std::vector<double> x, y, z, value;     // sorted points (structure of arrays)
+  std::vector<std::uint32_t> src;         // index of each sorted point in the source point_grid
+  std::vector<std::uint32_t> col_start;   // columns + 1 offsets into the sorted points
+  std::vector<std::uint32_t> col_of;      // column of each sorted point
+  double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
+  std::uint32_t nx = 1, ny = 1;
+};
 
-  // Lexicographically positive neighbour offsets: each unordered cell pair once.
-  static constexpr int forward[13][3] = {{1, -1, -1}, {1, -1, 0}, {1, -1, 1}, {1, 0, -1}, {1, 0, 0},
-                                         {1, 0, 1},   {1, 1, -1}, {1, 1, 0},  {1, 1, 1},  {0, 1, -1},
-                                         {0, 1, 0},   {0, 1, 1},  {0, 0, 1}};
-  auto process_cell = [&](std::uint32_t cx, std::uint32_t cy, std::uint32_t cz) {
-    const std::uint32_t c = g.cell_index(cx, cy, cz);
-    const std::uint32_t b0 = g.cell_start[c], b1 = g.cell_start[c + 1];
-    std::array<std::pair<std::uint32_t, std::uint32_t>, 14> ranges{};
-    std::size_t nr = 0;
-    for (const auto& o : forward) {
-      const long long nx = static_cast<long long>(cx) + o[0], ny = static_cast<long long>(cy) + o[1], nz = static_cast<long long>(cz) + o[2];
-      if (nx >= g.n[0] || ny < 0 || ny >= g.n[1] || nz < 0 || nz >= g.n[2]) continue;
-      const std::uint32_t d = g.cell_index(static_cast<std::uint32_t>(nx), static_cast<std::uint32_t>(ny),
-                                           static_cast<std::uint32_t>(nz));
-      if (g.cell_start[d] != g.cell_start[d + 1]) ranges[nr++] = {g.cell_start[d], g.cell_start[d + 1]};
-    }
-    std::array<double, 64> local{};
-    for (std::uint32_t i = b0; i < b1; ++i) {
-      std::fill(local.begin(), local.begin() + static_cast<std::ptrdiff_t>(2 * L), 0.0);
-      const double xi = g.x[i], yi = g.y[i], zi = g.z[i], ci = g.value[i];
-      auto visit = [&](std::uint32_t j0, std::uint32_t j1) {
-        for (std::uint32_t j = j0; j < j1; ++j) {
-          const double dx = g.x[j] - xi, dy = g.y[j] - yi, dz = g.z[j] - zi;
-          const double d2 = dx * dx + dy * dy + dz * dz;
-          if (d2 > r2max) continue;
-          const double cj = g.value[j];
-          double* aj = &acc[std::size_t{j} * 2 * L];
-          for (std::size_t u = L; u-- > 0;) {
-            if (d2 > r2[u]) break;
-            const double w = exp_neg2(-d2 * a[u]);
-            local[2 * u] += w * cj;
-            local[2 * u + 1] += w;
-            aj[2 * u] += w * ci;
-            aj[2 * u + 1] += w;
+// Builds a column_grid with columns about `width` wide (wider when needed to keep the column
+// count O(points)). O(P log P).
+inline column_grid make_column_grid(const point_grid& g, double width) {
+  column_grid c;
+  const std::size_t P = g.x.size();
+  double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
+  for (std::size_t k = 0; k < P; ++k)
+    xlo = std::min(xlo, g.x[k]), xhi = std::max(xhi, g.x[k]), ylo = std::min(ylo, g.y[k]), yhi = std::max(yhi, g.y[k]);
+  double h = width > 0.0 ? width : 1.0;
+  const double max_cols = 4.0 * static_cast<double>(P) + 64.0;
+  while ((std::floor((xhi - xlo) / h) + 1.0) * (std::floor((yhi - ylo) / h) + 1.0) > max_cols) h *= 1.25;
+  c.x0 = xlo, c.y0 = ylo, c.h = h;
+  c.nx = static_cast<std::uint32_t>(std::floor((xhi - xlo) / h)) + 1;
+  c.ny = static_cast<std::uint32_t>(std::floor((yhi - ylo) / h)) + 1;
+  auto col = [&](std::size_t k) {
+    const auto cx = std::min(static_cast<std::uint32_t>((g.x[k] - xlo) / h), c.nx - 1);
+    const auto cy = std::min(static_cast<std::uint32_t>((g.y[k] - ylo) / h), c.ny - 1);
+    return cx * c.ny + cy;
+  };
+  std::vector<std::uint32_t> order(P);
+  c.col_start.assign(std::size_t{c.nx} * c.ny + 1, 0);
+  for (std::size_t k = 0; k < P; ++k) ++c.col_start[col(k) + 1];
+  for (std::size_t q = 0; q + 1 < c.col_start.size(); ++q) c.col_start[q + 1] += c.col_start[q];
+  {
+    std::vector<std::uint32_t> cursor(c.col_start.begin(), c.col_start.end() - 1);
+    for (std::size_t k = 0; k < P; ++k) order[cursor[col(k)]++] = static_cast<std::uint32_t>(k);
+  }
+  for (std::size_t q = 0; q + 1 < c.col_start.size(); ++q)
+    std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t a, std::uint32_t b) {
+      return g.z[a] != g.z[b] ? g.z[a] < g.z[b] : g.id[a] < g.id[b];
+    });
+  c.x.resize(P), c.y.resize(P), c.z.resize(P), c.value.resize(P), c.col_of.resize(P);
+  for (std::size_t k = 0; k < P; ++k) {
+    const std::uint32_t s = order[k];
+    c.x[k] = g.x[s], c.y[k] = g.y[s], c.z[k] = g.z[s], c.value[k] = g.value[s];
+    c.col_of[k] = col(s);
+  }
+  c.src = std::move(order);
+  return c;
+}
+
+// Weights of one σ from the next: w_σ = exp(−d²/2σ²) = (w_2σ)⁴, so only the σ whose double is
+// not in the set need an exp. pow_of[u] = index of 2σ_u, or -1.
+struct sigma_table {
+  std::vector<double> r2, a;   // ball radius² (2σ)² and 1/(2σ²), ascending σ
+  std::vector<int> pow_of;
+};
+
+inline sigma_table make_sigma_table(const std::vector<double>& sigma) {
+  sigma_table t;
+  const std::size_t L = sigma.size();
+  t.r2.resize(L), t.a.resize(L), t.pow_of.assign(L, -1);
+  for (std::size_t u = 0; u < L; ++u) {
+    t.r2[u] = 4.0 * sigma[u] * sigma[u], t.a[u] = 1.0 / (2.0 * sigma[u] * sigma[u]);
+    for (std::size_t v = u + 1; v < L; ++v)
+      if (sigma[v] == 2.0 * sigma[u]) t.pow_of[u] = static_cast<int>(v);
+  }
+  return t;
+}
+
+// The pair kernel works on blocks of 4 candidates ("lanes"), held in G vectors of V (G·width
+// = 4). With GCC/Clang V is a vector extension type: 2 doubles (SSE2/NEON) by default, 4 in the
+// AVX2+FMA version chosen at run time on x86-64; other compilers get a plain 4-double struct.
+// Every lane receives the same operations in the same order in each version, so the versions
+// differ only by FMA contraction (relative 1e-16 per operation).
+inline constexpr std::size_t block_lanes = 8;
+inline constexpr std::size_t fallback_width = 4;
+
+struct lanes_fallback {  // 4 doubles, for compilers without vector extensions
+  double v[fallback_width];
+};
+struct mask_fallback {
+  bool v[fallback_width];
+};
+inline lanes_fallback operator+(lanes_fallback a, lanes_fallback b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] += b.v[l];
+  return a;
+}
+inline lanes_fallback operator*(lanes_fallback a, lanes_fallback b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] *= b.v[l];
+  return a;
+}
+inline lanes_fallback operator+(lanes_fallback a, double b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] += b;
+  return a;
+}
+inline lanes_fallback operator-(lanes_fallback a, double b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] -= b;
+  return a;
+}
+inline lanes_fallback operator*(lanes_fallback a, double b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] *= b;
+  return a;
+}
+inline mask_fallback operator<=(lanes_fallback a, double b) {
+  mask_fallback m;
+  for (std::size_t l = 0; l < fallback_width; ++l) m.v[l] = a.v[l] <= b;
+  return m;
+}
+
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // vectors only pass between inlined helpers
+using v2d = double __attribute__((vector_size(16)));
+using v4d = double __attribute__((vector_size(32)));
+// out = v where m, else +0 (bitwise, so an Inf outside the ball is harmless). Arguments by
+// reference: vector arguments by value would trip GCC's -Wpsabi note in the user's code.
+template <class V, class M>
+INFOLERP_SALIENCY_INLINE void keep(V& out, const M& m, const V& v) {
+  out = reinterpret_cast<V>(m & reinterpret_cast<M>(v));
+}
+#endif
+inline void keep(lanes_fallback& out, const mask_fallback& m, const lanes_fallback& v) {
+  for (std::size_t l = 0; l < fallback_width; ++l) out.v[l] = m.v[l] ? v.v[l] : 0.0;
+}
+
+template <class V>
+INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
+  std::memcpy(&v, p, sizeof v);
+}
+
+// For each sorted point i in [first, last): Σ_j w_u(d)·value_j / Σ_j w_u(d) over the points j
+// within each ball (i itself included), written to avg[u * P + src[i]]. Candidates come in
+// z-runs of the columns near i, 4 lanes at a time; σ from the largest down, stopping at the
+// first ball that holds none of the 4. Each lane accumulates its own partial sums, which are
+// added in a fixed order at the end: the result depends on the data only.
+template <class V>
+INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
+                          std::size_t last, double* avg) {
+  constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
+  const std::size_t L = t.r2.size(), P = g.x.size();
+  const double r2max = t.r2[L - 1];
+  for (std::size_t i = first; i < last; ++i) {
+    const double xi = g.x[i], yi = g.y[i], zi = g.z[i];
+    V acc_n[32][G] = {}, acc_d[32][G] = {}, w[32][G];
+    const std::uint32_t cx = g.col_of[i] / g.ny, cy = g.col_of[i] % g.ny;
+    const std::uint32_t ax0 = cx > span ? cx - span : 0, ax1 = std::min(cx + span, g.nx - 1);
+    const std::uint32_t ay0 = cy > span ? cy - span : 0, ay1 = std::min(cy + span, g.ny - 1);
+    for (std::uint32_t ax = ax0; ax <= ax1; ++ax)
+      for (std::uint32_t ay = ay0; ay <= ay1; ++ay) {
+        const std::uint32_t q = ax * g.ny + ay;
+        if (g.col_start[q] == g.col_start[q + 1]) continue;
+        const double lx = g.x0 + ax * g.h, ly = g.y0 + ay * g.h;
+        const double gx = std::max({0.0, lx - xi, xi - (lx + g.h)}), gy = std::max({0.0, ly - yi, yi - (ly + g.h)});
+        const double dxy2 = gx * gx + gy * gy;
+        if (dxy2 > r2max) continue;
+        const double half = std::sqrt(r2max - dxy2);
+        const double* zb = g.z.data() + g.col_start[q];
+        const double* ze = g.z.data() + g.col_start[q + 1];
+        const std::size_t j0 = static_cast<std::size_t>(std::lower_bound(zb, ze, zi - half) - g.z.data());
+        const std::size_t j1 = static_cast<std::size_t>(std::upper_bound(zb, ze, zi + half) - g.z.data());
+        for (std::size_t j = j0; j < j1; j += block_lanes) {
+          const double *xs = &g.x[j], *ys = &g.y[j], *zs = &g.z[j], *cs = &g.value[j];
+          double px[block_lanes], py[block_lanes], pz[block_lanes], pc[block_lanes];
+          if (j + block_lanes > j1) {  // tail: pad with points outside every ball
+            for (std::size_t l = 0; l < block_lanes; ++l) {
+              const bool in = j + l < j1;
+              px[l] = in ? g.x[j + l] : xi, py[l] = in ? g.y[j + l] : yi;
+              pz[l] = in ? g.z[j + l] : zi + 4.0 * half + 1.0, pc[l] = in ? g.value[j + l] : 0.0;
+            }
+            xs = px, ys = py, zs = pz, cs = pc;
+          }
+          V d2[G];
+          double dmin = std::numeric_limits<double>::infinity();
+          for (std::size_t k = 0; k < G; ++k) {
+            const std::size_t o = k * width;
+            V vx, vy, vz;
+            load_lanes(vx, xs + o), load_lanes(vy, ys + o), load_lanes(vz, zs + o);
+            const V dx = vx - xi, dy = vy - yi, dz = vz - zi;
+            d2[k] = dx * dx + dy * dy + dz * dz;
+          }
+          {
+            double d[block_lanes];
+            std::memcpy(d, d2, sizeof d);
+            for (std::size_t l = 0; l < block_lanes; ++l) dmin = std::min(dmin, d[l]);
+          }
+          for (std::size_t u = L; u-- > 0 && dmin <= t.r2[u];) {  // smaller σ have smaller balls
+            const int p = t.pow_of[u];
+            for (std::size_t k = 0; k < G; ++k) {
+              if (p >= 0) {
+                const V s2 = w[p][k] * w[p][k];
+                w[u][k] = s2 * s2;
+              } else {
+                w[u][k] = d2[k] * t.a[u];
+                exp_neg_inplace(w[u][k]);
+              }
+              V m;
+              keep(m, d2[k] <= t.r2[u], w[u][k]);
+              V c;
+              load_lanes(c, cs + k * width);
+              acc_n[u][k] = acc_n[u][k] + m * c;
+              acc_d[u][k] = acc_d[u][k] + m;
+            }
           }
         }
-      };
-      visit(i + 1, b1);
-      for (std::size_t r = 0; r < nr; ++r) visit(ranges[r].first, ranges[r].second);
-      double* ai = &acc[std::size_t{i} * 2 * L];
-      for (std::size_t u = 0; u < 2 * L; ++u) ai[u] += local[u];
-    }
-  };
-  // 18 colours; cells of one colour write to disjoint vertex sets (see the top of the file).
-  std::vector<std::uint32_t> cells;
-  for (std::uint32_t colour = 0; colour < 18; ++colour) {
-    cells.clear();
-    for (std::uint32_t cx = colour / 9; cx < g.n[0]; cx += 2)
-      for (std::uint32_t cy = (colour / 3) % 3; cy < g.n[1]; cy += 3)
-        for (std::uint32_t cz = colour % 3; cz < g.n[2]; cz += 3) {
-          const std::uint32_t c = g.cell_index(cx, cy, cz);
-          if (g.cell_start[c] != g.cell_start[c + 1]) cells.push_back(c);
-        }
-    exec.parallel_for(cells.size(), std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const std::uint32_t c = cells[k];
-        process_cell(c / (g.n[1] * g.n[2]), (c / g.n[2]) % g.n[1], c % g.n[2]);
       }
-    });
+    for (std::size_t u = 0; u < L; ++u) {
+      double n[block_lanes], d[block_lanes];
+      std::memcpy(n, acc_n[u], sizeof n);
+      std::memcpy(d, acc_d[u], sizeof d);
+      for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
+        for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
+      avg[u * P + g.src[i]] = n[0] / d[0];
+    }
   }
+}
+
+inline void gather_points_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
+                                   std::size_t last, double* avg) {
+#if defined(__GNUC__) || defined(__clang__)
+  gather_points<v2d>(g, t, span, first, last, avg);
+#else
+  gather_points<lanes_fallback>(g, t, span, first, last, avg);
+#endif
+}
+
+// Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
+#define INFOLERP_SALIENCY_AVX2 1
+__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const sigma_table& t,
+                                                                   std::uint32_t span, std::size_t first,
+                                                                   std::size_t last, double* avg) {
+  gather_points<v4d>(g, t, span, first, last, avg);
+}
+inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+#endif
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+// Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
+// points. Returns avg[u * P + k] for point k of g. Each point gathers its own sums (every pair
+// is evaluated from both ends), so points are independent: parallel with no write conflicts,
+// identical bits for any executor and thread count.
+template <class E>
+std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const std::vector<double>& sigma,
+                                            std::size_t grain) {
+  const std::size_t P = pg.x.size(), L = sigma.size();
+  const sigma_table t = make_sigma_table(sigma);
+  const double rmax = 2.0 * sigma[L - 1];
+  const column_grid g = make_column_grid(pg, rmax / 3.0);
+  const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
   std::vector<double> avg(L * P);
-  for (std::size_t k = 0; k < P; ++k)
-    for (std::size_t u = 0; u < L; ++u) avg[u * P + k] = acc[k * 2 * L + 2 * u] / acc[k * 2 * L + 2 * u + 1];
+#ifdef INFOLERP_SALIENCY_AVX2
+  const bool avx2 = cpu_has_avx2_fma();
+#endif
+  exec.parallel_for(P, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+#ifdef INFOLERP_SALIENCY_AVX2
+    if (avx2) return gather_points_avx2(g, t, span, b, e, avg.data());
+#endif
+    gather_points_portable(g, t, span, b, e, avg.data());
+  });
   return avg;
 }
 
@@ -334,9 +557,10 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
 // scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5, a σ whose square is not a
-// normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a mesh
-// whose bounding box has zero diagonal (degenerate_triangle).
-// Complexity, exact: O(V + T + pairs within 2σ_max · distinct σs); approximate: O(V·σs·k) with
+// normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a
+// mesh whose bounding box has zero diagonal (degenerate_triangle).
+// Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the pairs
+// within 2σ_max, each counted from both ends); approximate: O(V·σs·k) with
 // k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (16 doubles per
 // vertex and distinct σ at most; never per pair). Parallel through exec; the result is
 // identical for every executor and thread count.
@@ -432,9 +656,10 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
       is_max[v] = used[v];
       if (used[v] && global == nv && s[v] == mx) global = v;
     }
+    const double tie = 1e-12 * mx;  // differences below this are rounding, not structure
     for (const glm::uvec2& e : topo->edges) {
-      if (s[e.x] <= s[e.y]) is_max[e.x] = 0;
-      if (s[e.y] <= s[e.x]) is_max[e.y] = 0;
+      if (s[e.x] <= s[e.y] + tie) is_max[e.x] = 0;
+      if (s[e.y] <= s[e.x] + tie) is_max[e.y] = 0;
     }
     double sum_max = 0.0;
     std::size_t count_max = 0;

@@ -27,37 +27,19 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <queue>
 #include <span>
-#include <tuple>
+#include <utility>
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
 
 namespace infolerp {
-
-// splitmix64 (Steele, Lea, Flood 2014): the same sequence on every platform and library,
-// unlike std:: distributions. uniform(n) is unbiased (rejection).
-struct splitmix64 {
-  std::uint64_t state = 0;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
-  // Uniform integer in [0, n). Precondition: n > 0.
-  std::uint64_t uniform(std::uint64_t n) {
-    const std::uint64_t threshold = (0 - n) % n;  // 2^64 mod n
-    for (;;)
-      if (const std::uint64_t x = next(); x >= threshold) return x % n;
-  }
-};
 
 struct salient_clustering_options {
   std::uint32_t clusters = 10;    // C, the number of seeded clusters
@@ -77,96 +59,201 @@ struct salient_clusters {
 };
 
 namespace detail {
+// The dual graph with per-face data, faces renumbered along a Morton curve of their centroids so
+// that neighbours are close in memory (the growth and re-seeding loops are memory-bound; mesh
+// files often list faces in no spatial order). Every tie-break uses the original face index,
+// so the renumbering does not change any result.
 struct face_data {
-  std::vector<glm::dvec3> centroid, normal;  // normal unit (0 for zero-area faces)
-  std::vector<double> area, saliency;
+  struct hot_part {     // what a neighbour visit reads, in one place
+    glm::dvec3 normal;  // unit (0 for zero-area faces)
+    double saliency;    // mean of the corners' vertex saliency
+  };
+  std::vector<hot_part> hot;
+  std::vector<double> area;
+  std::vector<std::uint32_t> original;     // internal face -> the mesh's face index
+  std::vector<std::uint32_t> nb_offsets;   // CSR dual graph in internal indices
+  std::vector<std::uint32_t> nb;
+  std::vector<double> step_length;         // per dual edge: |x_g − x_f| (centroids)
+  std::vector<char> on_boundary;           // per face: has a mesh-boundary edge
+  std::vector<std::uint32_t> vf_offsets;   // CSR: internal faces around each vertex
+  std::vector<std::uint32_t> vf;
 };
 
-// One growth phase from the given seed vertices. vertex_faces: CSR faces around each vertex.
-inline std::vector<std::uint32_t> grow_clusters(const face_data& fd, const mesh_topology& topo,
-                                                std::span<const std::uint32_t> vf_offsets,
-                                                std::span<const std::uint32_t> vf, std::span<const double> vsal,
-                                                std::span<const std::uint32_t> seeds, double lambda_n) {
+template <class M>
+face_data make_face_data(const M& m, const mesh_topology& topo, std::span<const double> saliency) {
+  const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
+  std::vector<glm::dvec3> centroid(nt);
+  bounding_box box;
+  for (std::size_t t = 0; t < nt; ++t) centroid[t] = triangle_centroid(corners(m, t)), box.extend(centroid[t]);
+  const glm::dvec3 ext = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> key(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    std::uint64_t code = 0;
+    for (int a = 0; a < 3; ++a) {
+      const auto q = static_cast<std::uint64_t>(std::clamp((centroid[t][a] - box.lo[a]) / ext[a], 0.0, 1.0) * 2097151.0);
+      for (int bit = 0; bit < 21; ++bit) code |= (q >> bit & 1u) << (3 * bit + a);
+    }
+    key[t] = {code, static_cast<std::uint32_t>(t)};
+  }
+  std::sort(key.begin(), key.end());
+  face_data fd;
+  fd.original.resize(nt);
+  std::vector<std::uint32_t> internal(nt);
+  for (std::size_t i = 0; i < nt; ++i) fd.original[i] = key[i].second, internal[key[i].second] = static_cast<std::uint32_t>(i);
+  fd.hot.resize(nt), fd.area.resize(nt), fd.on_boundary.assign(nt, 0);
+  fd.nb_offsets.assign(nt + 1, 0);
+  fd.nb.reserve(topo.neighbours.size()), fd.step_length.reserve(topo.neighbours.size());
+  for (std::size_t i = 0; i < nt; ++i) {
+    const std::uint32_t t = fd.original[i];
+    const triangle_corners c = corners(m, t);
+    fd.hot[i].normal = glm::dvec3(triangle_normal(c));
+    fd.area[i] = triangle_area(c);
+    const glm::uvec3 tri = mesh_triangle(m, t);
+    fd.hot[i].saliency = (saliency[tri.x] + saliency[tri.y] + saliency[tri.z]) / 3.0;
+    for (std::uint32_t g : topo.neighbours_of(t))
+      fd.nb.push_back(internal[g]), fd.step_length.push_back(glm::length(centroid[g] - centroid[t]));
+    fd.nb_offsets[i + 1] = static_cast<std::uint32_t>(fd.nb.size());
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t e = topo.triangle_edges[3 * t + k];
+      if (e != invalid_id && topo.is_boundary_edge(e)) fd.on_boundary[i] = 1;
+    }
+  }
+  fd.vf_offsets.assign(nv + 1, 0), fd.vf.resize(3 * nt);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c) ++fd.vf_offsets[mesh_triangle(m, t)[c] + 1];
+  for (std::size_t v = 0; v < nv; ++v) fd.vf_offsets[v + 1] += fd.vf_offsets[v];
+  std::vector<std::uint32_t> cursor(fd.vf_offsets.begin(), fd.vf_offsets.end() - 1);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c) fd.vf[cursor[mesh_triangle(m, t)[c]]++] = internal[t];
+  return fd;
+}
+
+// Buffers reused by every growth and re-seeding round (no allocation per round).
+struct clustering_workspace {
+  struct grow_entry {
+    double cost, neg_s;
+    std::uint32_t cluster, face;  // internal face
+  };
+  struct dist_entry {
+    double dist;
+    std::uint32_t face;  // internal face
+  };
+  std::vector<grow_entry> grow_heap;
+  std::vector<dist_entry> dist_heap;
+  std::vector<double> dist;  // per face
+  std::vector<std::uint32_t> best_cluster;  // growth: cluster of a face's best push so far (uses dist for its cost)
+};
+
+// One growth phase from the given seed vertices; label gets each internal face's cluster.
+// Queue order: (cost, −S_f', cluster, original face index).
+inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std::span<const std::uint32_t> seeds,
+                          double lambda_n, clustering_workspace& ws, std::vector<std::uint32_t>& label) {
+  using entry = clustering_workspace::grow_entry;
   const std::size_t nt = fd.area.size(), C = seeds.size();
-  std::vector<std::uint32_t> label(nt, invalid_id);
+  label.assign(nt, invalid_id);
   std::vector<glm::dvec3> nsum(C, glm::dvec3(0.0));
   std::vector<double> ssum(C, 0.0), s0(C);
   std::vector<std::uint32_t> nfaces(C, 0);
-  using entry = std::tuple<double, double, std::uint32_t, std::uint32_t, std::uint32_t>;  // cost, −S, cluster, face, from
-  std::priority_queue<entry, std::vector<entry>, std::greater<entry>> queue;
+  auto& heap = ws.grow_heap;
+  heap.clear();
+  const auto greater = [&](const entry& x, const entry& y) {
+    if (x.cost != y.cost) return x.cost > y.cost;
+    if (x.neg_s != y.neg_s) return x.neg_s > y.neg_s;
+    if (x.cluster != y.cluster) return x.cluster > y.cluster;
+    return fd.original[x.face] > fd.original[y.face];
+  };
+  // A face is pushed only when (cost, cluster) beats its earlier pushes: a worse entry for the
+  // same face would be popped after the better one, when the face is already labelled.
+  ws.dist.assign(nt, std::numeric_limits<double>::infinity());
+  ws.best_cluster.assign(nt, invalid_id);
+  auto push = [&](double cost, std::uint32_t c, std::uint32_t g) {
+    if (cost > ws.dist[g] || (cost == ws.dist[g] && c >= ws.best_cluster[g])) return;
+    ws.dist[g] = cost, ws.best_cluster[g] = c;
+    heap.push_back({cost, -fd.hot[g].saliency, c, g});
+    std::push_heap(heap.begin(), heap.end(), greater);
+  };
   for (std::uint32_t c = 0; c < C; ++c) {
     const std::uint32_t v = seeds[c];
     s0[c] = vsal[v];
-    for (std::uint32_t k = vf_offsets[v]; k < vf_offsets[v + 1]; ++k) {
-      nsum[c] += fd.normal[vf[k]] * fd.area[vf[k]];  // seed normal: the vertex's area-weighted normal
-      queue.emplace(0.0, -fd.saliency[vf[k]], c, vf[k], invalid_id);
+    for (std::uint32_t k = fd.vf_offsets[v]; k < fd.vf_offsets[v + 1]; ++k) {
+      nsum[c] += fd.hot[fd.vf[k]].normal * fd.area[fd.vf[k]];  // seed normal: the vertex's area-weighted normal
+      push(0.0, c, fd.vf[k]);
     }
   }
-  while (!queue.empty()) {
-    const auto [cost, neg_s, c, f, from] = queue.top();
-    queue.pop();
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), greater);
+    const entry top = heap.back();
+    heap.pop_back();
+    const std::uint32_t c = top.cluster, f = top.face;
     if (label[f] != invalid_id) continue;
     label[f] = c;
     if (nfaces[c] == 0) nsum[c] = glm::dvec3(0.0);  // from now on: the cluster's faces
-    nsum[c] += fd.normal[f] * fd.area[f];
-    ssum[c] += fd.saliency[f];
+    nsum[c] += fd.hot[f].normal * fd.area[f];
+    ssum[c] += fd.hot[f].saliency;
     ++nfaces[c];
     const double len = glm::length(nsum[c]);
     const glm::dvec3 mean_n = len > 0.0 ? nsum[c] / len : glm::dvec3(0.0);
     const double mean_s = ssum[c] / nfaces[c];
-    for (std::uint32_t g : topo.neighbours_of(f)) {
+    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
+      const std::uint32_t g = fd.nb[k];
       if (label[g] != invalid_id) continue;
-      const double sg = fd.saliency[g];
-      const double step = (lambda_n - glm::dot(mean_n, fd.normal[g])) *
-                          (std::abs(mean_s - sg) * std::abs(s0[c] - sg) * std::abs(fd.saliency[f] - sg)) *
-                          glm::length(fd.centroid[g] - fd.centroid[f]);
-      queue.emplace(cost + std::max(step, 0.0), -sg, c, g, f);
+      const double sg = fd.hot[g].saliency;
+      const double step = (lambda_n - glm::dot(mean_n, fd.hot[g].normal)) *
+                          (std::abs(mean_s - sg) * std::abs(s0[c] - sg) * std::abs(fd.hot[f].saliency - sg)) *
+                          fd.step_length[k];
+      push(top.cost + std::max(step, 0.0), c, g);
     }
   }
-  return label;
 }
 
 // Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
-// Dijkstra search from the cluster's border faces inward.
+// Dijkstra search from the cluster's border faces inward (ties: original face index).
 template <class M>
-std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, const mesh_topology& topo,
-                                  std::span<const std::uint32_t> label, std::span<const double> vsal,
-                                  std::span<const std::uint32_t> old_seeds) {
+std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
+                                  std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
+                                  clustering_workspace& ws) {
+  using entry = clustering_workspace::dist_entry;
   const std::size_t nt = label.size(), C = old_seeds.size();
   std::vector<double> smax(C, 0.0);
   for (std::size_t f = 0; f < nt; ++f)
-    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.saliency[f]);
-  using entry = std::tuple<double, std::uint32_t>;  // distance, face (clusters are disjoint)
-  std::priority_queue<entry, std::vector<entry>, std::greater<entry>> queue;
-  std::vector<double> dist(nt, std::numeric_limits<double>::infinity());
+    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.hot[f].saliency);
+  auto& heap = ws.dist_heap;
+  heap.clear();
+  const auto greater = [&](const entry& x, const entry& y) {
+    return x.dist != y.dist ? x.dist > y.dist : fd.original[x.face] > fd.original[y.face];
+  };
+  ws.dist.assign(nt, std::numeric_limits<double>::infinity());
   for (std::size_t f = 0; f < nt; ++f) {
     if (label[f] >= C) continue;
-    bool border = false;
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t e = topo.triangle_edges[3 * f + static_cast<std::size_t>(c)];
-      if (e != invalid_id && topo.is_boundary_edge(e)) border = true;
-    }
-    for (std::uint32_t g : topo.neighbours_of(f)) border = border || label[g] != label[f];
-    if (border) dist[f] = 0.0, queue.emplace(0.0, static_cast<std::uint32_t>(f));
+    bool border = fd.on_boundary[f] != 0;
+    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) border = border || label[fd.nb[k]] != label[f];
+    if (border) ws.dist[f] = 0.0, heap.push_back({0.0, static_cast<std::uint32_t>(f)});
   }
+  std::make_heap(heap.begin(), heap.end(), greater);
   std::vector<std::uint32_t> last(C, invalid_id);
-  while (!queue.empty()) {
-    const auto [d, f] = queue.top();
-    queue.pop();
-    if (d > dist[f]) continue;
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), greater);
+    const auto [d, f] = heap.back();
+    heap.pop_back();
+    if (d > ws.dist[f]) continue;
     const std::uint32_t c = label[f];
     last[c] = f;  // popped in ascending distance: the final pop per cluster is the farthest
     const double scale = smax[c] > 0.0 ? 1.0 / smax[c] : 0.0;
-    for (std::uint32_t g : topo.neighbours_of(f)) {
+    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
+      const std::uint32_t g = fd.nb[k];
       if (label[g] != c) continue;
-      const double step = glm::length(fd.centroid[g] - fd.centroid[f]) * (smax[c] > 0.0 ? fd.saliency[g] * scale : 1.0);
-      if (d + step < dist[g]) dist[g] = d + step, queue.emplace(d + step, g);
+      const double step = fd.step_length[k] * (smax[c] > 0.0 ? fd.hot[g].saliency * scale : 1.0);
+      if (d + step < ws.dist[g]) {
+        ws.dist[g] = d + step;
+        heap.push_back({d + step, g});
+        std::push_heap(heap.begin(), heap.end(), greater);
+      }
     }
   }
   std::vector<std::uint32_t> seeds(old_seeds.begin(), old_seeds.end());
   for (std::size_t c = 0; c < C; ++c) {
     if (last[c] == invalid_id) continue;  // no border: keep the seed
-    const glm::uvec3 tri = mesh_triangle(m, last[c]);
+    const glm::uvec3 tri = mesh_triangle(m, fd.original[last[c]]);
     std::uint32_t best = tri.x;
     for (int k = 1; k < 3; ++k)
       if (vsal[tri[k]] > vsal[best] || (vsal[tri[k]] == vsal[best] && tri[k] < best)) best = tri[k];
@@ -180,7 +267,10 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, const mesh_to
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
 // non-finite or negative saliency (names the vertex); clusters == 0 or more clusters than the
 // pool or the triangle count can seed; pool_multiplier < 1; normal_weight < 1 (bad_parameter).
-// Complexity O(iterations · T log T); allocation O(T) (queues hold up to ~3T entries). Serial.
+// Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
+// plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
+// reused by every round). Serial. bunny00 (75k faces), C = 10, 16 rounds: ~0.7 s on a loaded
+// 2-core EPYC VM (was 1.05 s before the renumbering and the lighter queue entries).
 template <class M>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,
                                             const salient_clustering_options& opt = {}) {
@@ -201,19 +291,11 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
   auto topo = build_topology(m);
   if (!topo.ok()) return topo.error();
 
-  // Vertices used by triangles, most salient first (ties: lower index), and faces per vertex.
-  std::vector<std::uint32_t> vf_offsets(nv + 1, 0), vf(3 * nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) ++vf_offsets[mesh_triangle(m, t)[c] + 1];
-  for (std::size_t v = 0; v < nv; ++v) vf_offsets[v + 1] += vf_offsets[v];
-  {
-    std::vector<std::uint32_t> cursor(vf_offsets.begin(), vf_offsets.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t)
-      for (int c = 0; c < 3; ++c) vf[cursor[mesh_triangle(m, t)[c]]++] = static_cast<std::uint32_t>(t);
-  }
+  // Vertices used by triangles, most salient first (ties: lower index).
+  const detail::face_data fd = detail::make_face_data(m, *topo, saliency);
   std::vector<std::uint32_t> order;
   for (std::size_t v = 0; v < nv; ++v)
-    if (vf_offsets[v + 1] > vf_offsets[v]) order.push_back(static_cast<std::uint32_t>(v));
+    if (fd.vf_offsets[v + 1] > fd.vf_offsets[v]) order.push_back(static_cast<std::uint32_t>(v));
   const auto pool_size = static_cast<std::size_t>(
       std::min<double>(static_cast<double>(order.size()), std::ceil(opt.pool_multiplier * opt.clusters)));
   if (pool_size < opt.clusters)
@@ -232,26 +314,17 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     seeds[c] = order[c];
   }
 
-  detail::face_data fd;
-  fd.centroid.resize(nt), fd.normal.resize(nt), fd.area.resize(nt), fd.saliency.resize(nt);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const triangle_corners c = corners(m, t);
-    fd.centroid[t] = triangle_centroid(c);
-    fd.normal[t] = glm::dvec3(triangle_normal(c));
-    fd.area[t] = triangle_area(c);
-    const glm::uvec3 tri = mesh_triangle(m, t);
-    fd.saliency[t] = (saliency[tri.x] + saliency[tri.y] + saliency[tri.z]) / 3.0;
-  }
-
   salient_clusters out;
   std::vector<std::vector<std::uint32_t>> history;
+  detail::clustering_workspace ws;
+  std::vector<std::uint32_t> label;  // per internal face
   for (;;) {
-    out.cluster = detail::grow_clusters(fd, *topo, vf_offsets, vf, saliency, seeds, opt.normal_weight);
+    detail::grow_clusters(fd, saliency, seeds, opt.normal_weight, ws, label);
     out.seeds = seeds;
     ++out.iterations;
     history.push_back(seeds);
     if (out.iterations >= opt.max_iterations) break;
-    auto next = detail::reseed(m, fd, *topo, out.cluster, saliency, seeds);
+    auto next = detail::reseed(m, fd, label, saliency, seeds, ws);
     const auto seen = std::find(history.begin(), history.end(), next);
     if (seen != history.end()) {
       out.converged = true;
@@ -260,6 +333,8 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     }
     seeds = std::move(next);
   }
+  out.cluster.resize(nt);
+  for (std::size_t i = 0; i < nt; ++i) out.cluster[fd.original[i]] = label[i];
   // Faces no seed reached (other components): one extra cluster per unreached component.
   out.count = opt.clusters;
   std::vector<std::uint32_t> stack;

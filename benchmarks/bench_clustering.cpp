@@ -1,0 +1,241 @@
+// Clustering (issue 3) on CGAL's refined_elephant (~89k triangles) and procedural meshes.
+//   BM_Clustering_RefinedElephant   Algorithm 1: visibility → orientation → stretch, one core,
+//                                   visibility rays precomputed outside the timed loop. Goal ≤ 150 ms.
+//   BM_OrientationChannel/K, BM_StretchChannel/K   one-channel clustering, K = 0 (exact) or bins:
+//                                   time, JS abs error vs exact, adjusted Rand index vs exact.
+//   BM_VisibilityChannel_Total / BM_VisibilityChannel_RaysOnly   the channel against the raw time
+//                                   of its own rays through the same tracer. Goal ≤ 1.3×.
+// Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <vector>
+#include "infolerp/cluster/cluster_mesh.hpp"
+#include "support/embree_tracer.hpp"
+#include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
+
+using namespace infolerp;
+
+namespace {
+
+// Spherical texcoords per corner (u unwrapped per triangle), so the stretch channel has work.
+void add_spherical_texcoords(indexed_mesh& m) {
+  const bounding_box box = mesh_bounds(m);
+  const glm::dvec3 c = box.center();
+  m.texcoords.clear();
+  for (const auto& t : m.triangles) {
+    glm::dvec2 uv[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 d = glm::dvec3(m.positions[t[k]]) - c;
+      uv[k] = {std::atan2(d.y, d.x) / (2.0 * std::numbers::pi) + 0.5, std::acos(std::clamp(d.z / glm::length(d), -1.0, 1.0)) / std::numbers::pi};
+    }
+    const double hi = std::max({uv[0].x, uv[1].x, uv[2].x});
+    for (auto& x : uv)
+      if (hi - x.x > 0.5) x.x += 1.0;
+    for (auto& x : uv) m.texcoords.emplace_back(x);
+  }
+}
+
+struct elephant_scene {
+  indexed_mesh mesh;
+  mesh_topology topo;
+  std::unique_ptr<support::embree_device> device;
+  std::unique_ptr<support::embree_scene> tracer;
+  prepared_visibility_channel visibility;
+  bool ok = false;
+};
+
+const visibility_channel elephant_visibility{.threshold = 0.48, .viewpoints = 64, .samples_per_side = 2};
+
+elephant_scene& elephant() {
+  static elephant_scene s = [] {
+    elephant_scene e;
+    auto m = support::load_mesh(support::cgal_mesh("refined_elephant"));
+    if (!m) return e;
+    e.mesh = std::move(*m);
+    add_spherical_texcoords(e.mesh);
+    e.topo = std::move(*build_topology(e.mesh));
+    e.device = std::make_unique<support::embree_device>("threads=1");
+    e.tracer = std::make_unique<support::embree_scene>(*e.device);
+    if (!e.tracer->add_mesh(e.mesh) || !e.tracer->commit()) return e;
+    serial_executor exec;
+    e.visibility = std::move(*elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec));
+    e.ok = true;
+    return e;
+  }();
+  return s;
+}
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// Adjusted Rand index of two labelings (Hubert & Arabie 1985).
+double adjusted_rand_index(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, double> joint;
+  std::map<std::uint32_t, double> ra, rb;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    joint[{a[i], b[i]}] += 1.0;
+    ra[a[i]] += 1.0;
+    rb[b[i]] += 1.0;
+  }
+  auto c2 = [](double n) { return n * (n - 1.0) / 2.0; };
+  double sij = 0.0, sa = 0.0, sb = 0.0;
+  for (auto& [k, n] : joint) sij += c2(n);
+  for (auto& [k, n] : ra) sa += c2(n);
+  for (auto& [k, n] : rb) sb += c2(n);
+  const double expected = sa * sb / c2(static_cast<double>(a.size()));
+  const double maximum = 0.5 * (sa + sb);
+  return maximum == expected ? 1.0 : (sij - expected) / (maximum - expected);
+}
+
+void BM_Clustering_RefinedElephant(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  serial_executor exec;
+  mesh_clustering last;
+  for (auto _ : state) {
+    auto r = cluster_mesh(e.mesh, *e.tracer, exec, cluster_options{}, e.visibility,
+                          orientation_channel{.threshold = 0.02, .bins = 256}, stretch_channel{.threshold = 0.1, .bins = 256});
+    if (!r) return state.SkipWithError(r.error().message().c_str());
+    last = std::move(*r);
+    benchmark::DoNotOptimize(last);
+  }
+  state.counters["triangles"] = static_cast<double>(e.mesh.triangles.size());
+  state.counters["clusters"] = last.cluster_count;
+  for (std::size_t i = 0; i < last.channels.size(); ++i)
+    state.counters["after_ch" + std::to_string(i)] = last.channels[i].clusters_after;
+  state.counters["peak_rss_MB"] = peak_rss_mb();
+}
+BENCHMARK(BM_Clustering_RefinedElephant)->Unit(benchmark::kMillisecond);
+
+// One direct channel, exact (K = 0) against binned: time of init + clustering, JS error, ARI.
+template <class Channel, class Make>
+void direct_channel_bench(benchmark::State& state, const indexed_mesh& m, Make make_state, double threshold) {
+  const auto bins = static_cast<std::uint32_t>(state.range(0));
+  auto topo = build_topology(m);
+  std::vector<std::uint32_t> all(m.triangles.size()), scratch(m.triangles.size(), invalid_id);
+  std::iota(all.begin(), all.end(), 0u);
+  const element_graph g = subset_graph(*topo, all, scratch);
+  serial_executor exec;
+  const region_growing_options o{.threshold = threshold, .min_cluster_fraction = 0.001};
+  std::vector<std::uint32_t> labels;
+  for (auto _ : state) {
+    const auto s = make_state(bins);
+    auto r = grow_regions(s, g, o, exec);
+    labels = r->cluster_of;
+    benchmark::DoNotOptimize(labels);
+  }
+  // Reference: exact rows and their clustering (computed once per K, outside the timing).
+  const auto exact = make_state(0u);
+  const auto binned = make_state(bins);
+  double err_sum = 0.0, err_max = 0.0;
+  std::size_t pairs = 0;
+  for (std::uint32_t a = 0; a < all.size(); a += 97)
+    for (std::uint32_t b = 0; b < all.size(); b += 89) {
+      const double d = std::abs(binned.divergence(binned.class_of(a), binned.class_of(b)) -
+                                exact.divergence(exact.class_of(a), exact.class_of(b)));
+      err_sum += d;
+      err_max = std::max(err_max, d);
+      ++pairs;
+    }
+  static std::map<const void*, std::vector<std::uint32_t>> exact_labels;
+  auto& ref = exact_labels[&m];
+  if (ref.empty()) ref = grow_regions(exact, g, o, exec)->cluster_of;
+  state.counters["triangles"] = static_cast<double>(m.triangles.size());
+  state.counters["classes"] = static_cast<double>(binned.class_count());
+  state.counters["js_err_mean"] = err_sum / static_cast<double>(pairs);
+  state.counters["js_err_max"] = err_max;
+  state.counters["clusters"] = static_cast<double>(*std::max_element(labels.begin(), labels.end()) + 1);
+  state.counters["ari_vs_exact"] = adjusted_rand_index(labels, ref);
+}
+
+const indexed_mesh& torus() {
+  // Jittered deterministically so that no two normals tie (a symmetric torus makes seed choice
+  // among exactly tied candidates arbitrary, which says nothing about binning).
+  static const indexed_mesh m = [] {
+    auto t = support::make_torus(48, 24, 1.0f, 0.4f);
+    for (std::size_t v = 0; v < t.positions.size(); ++v) {
+      std::uint64_t h = (v + 1) * 0x9E3779B97F4A7C15ull;
+      h ^= h >> 31;
+      h *= 0xBF58476D1CE4E5B9ull;
+      h ^= h >> 29;
+      t.positions[v] *= 1.0f + 0.01f * (static_cast<float>(h % 2001) / 1000.0f - 1.0f);
+    }
+    return t;
+  }();
+  return m;
+}
+const indexed_mesh& uv_sphere() {
+  static const indexed_mesh m = support::make_uv_sphere(64, 32);
+  return m;
+}
+
+void BM_OrientationChannel(benchmark::State& state) {
+  const auto& m = torus();
+  static const auto normals = face_normals(m);
+  direct_channel_bench<orientation_channel>(
+      state, m, [&](std::uint32_t bins) { return make_orientation_state(normals, bins); }, 0.02);
+}
+BENCHMARK(BM_OrientationChannel)->Arg(0)->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+void BM_StretchChannel(benchmark::State& state) {
+  const auto& m = uv_sphere();
+  static const auto raw = *texture_stretch(m);
+  direct_channel_bench<stretch_channel>(
+      state, m, [&](std::uint32_t bins) { return make_stretch_state(raw, bins); }, 0.005);
+}
+BENCHMARK(BM_StretchChannel)->Arg(0)->Arg(64)->Arg(256)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+void BM_VisibilityChannel_Total(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  serial_executor exec;
+  for (auto _ : state) {
+    auto p = elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec);
+    benchmark::DoNotOptimize(p);
+  }
+  state.counters["triangles"] = static_cast<double>(e.mesh.triangles.size());
+}
+BENCHMARK(BM_VisibilityChannel_Total)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+// The same rays, same chunks, same tracer: only the trace_occluded calls are timed.
+void BM_VisibilityChannel_RaysOnly(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  const visibility_setup su = elephant_visibility.setup(e.mesh);
+  const std::size_t nt = e.mesh.triangles.size(), g = elephant_visibility.grain;
+  std::vector<ray> rays;
+  std::vector<std::uint32_t> slots;
+  std::vector<std::uint8_t> out;
+  std::size_t count = 0;
+  for (auto _ : state) {
+    double seconds = 0.0;
+    count = 0;
+    for (std::size_t first = 0; first < nt; first += g) {
+      rays.clear();
+      slots.clear();
+      make_visibility_rays(e.mesh, su, first, std::min(nt, first + g), rays, slots);
+      out.resize(rays.size());
+      const auto t0 = std::chrono::steady_clock::now();
+      trace_occluded(*e.tracer, std::span<const ray>(rays), std::span<std::uint8_t>(out));
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      count += rays.size();
+      benchmark::DoNotOptimize(out.data());
+    }
+    state.SetIterationTime(seconds);
+  }
+  state.counters["rays"] = static_cast<double>(count);
+}
+BENCHMARK(BM_VisibilityChannel_RaysOnly)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(2);
+
+}  // namespace

@@ -1,0 +1,261 @@
+#pragma once
+// Boundary smoothing (clustering paper §3.3, after Sander et al. [25]).
+// For each pair of neighbouring clusters A, B (seeds s_A, s_B) of one set:
+//   1. the boundary: the mesh edges shared by a triangle of A and one of B. Only an open
+//      boundary (one simple polyline with two end vertices) is smoothed; closed loops and
+//      boundaries in several pieces are left as they are.
+//   2. the band: triangles reachable from the boundary through triangles that are more similar
+//      to the other side's seed (JS(t, s_other) < JS(t, s_own)). Band edges: the boundary edges
+//      plus every edge of a band triangle whose two incident triangles both lie in A ∪ B (so no
+//      path can touch a third cluster; mesh-border edges are left out too).
+//   3. A* (Euclidean edge lengths, straight-line heuristic) through the band edges between the
+//      boundary's end vertices.
+//   4. A ∪ B is split along the new path; the part holding s_A becomes A, the part holding s_B
+//      becomes B. The change is kept only when the path splits A ∪ B into exactly these two
+//      connected parts, so clusters stay connected and third clusters are never modified.
+// Pairs are processed in increasing (A, B) order; deterministic.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <iterator>
+#include <limits>
+#include <queue>
+#include <span>
+#include <utility>
+#include <vector>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include "infolerp/cluster/channel.hpp"
+#include "infolerp/cluster/region_growing.hpp"
+#include "infolerp/core/mesh_traits.hpp"
+
+namespace infolerp {
+
+namespace detail {
+inline std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  return (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b);
+}
+// The mesh edge shared by two triangles (vertex ids), or false.
+inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint32_t& b) {
+  std::uint32_t found[2];
+  int n = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (p[i] == q[j] && n < 2 && (n == 0 || found[0] != p[i])) found[n++] = p[i];
+  if (n != 2) return false;
+  a = found[0];
+  b = found[1];
+  return true;
+}
+}  // namespace detail
+
+// Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
+// mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
+// Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
+// plus O(band · log band); divergences only for the boundary and band triangles.
+// Allocation O(M).
+template <class S, class M>
+std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
+                                double threshold, region_growing_result& r) {
+  static_assert(channel_state<S>);
+  const std::size_t n = g.size();
+  const std::uint32_t k = r.cluster_count();
+  if (k < 2 || r.all_alike || !(threshold > 0.0 && threshold < 1.0)) return 0;
+  std::vector<glm::uvec3> tri(n);
+  for (std::size_t i = 0; i < n; ++i) tri[i] = mesh_triangle(m, triangles[i]);
+  std::vector<std::uint32_t>& label = r.cluster_of;
+
+  // Neighbouring cluster pairs, ascending.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j : g.neighbours_of(i))
+      if (label[i] < label[j]) pairs.emplace_back(label[i], label[j]);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+
+  // Elements of each cluster (kept up to date as pairs are smoothed).
+  std::vector<std::vector<std::uint32_t>> members_of(k);
+  for (std::uint32_t i = 0; i < n; ++i) members_of[label[i]].push_back(i);
+
+  std::uint32_t moved = 0;
+  std::vector<std::uint32_t> region(n, invalid_id), stack, members;
+  // JS to the pair's two seeds, memoised per class for the current pair.
+  const std::size_t u = s.class_count();
+  std::vector<double> js_a(u), js_b(u);
+  std::vector<std::uint32_t> stamp(u, invalid_id);
+  std::uint32_t pair_index = 0;
+  for (const auto& [ca, cb] : pairs) {
+    ++pair_index;
+    members.clear();
+    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
+               std::back_inserter(members));
+    // 1. Boundary edges and the triangles on them.
+    std::vector<std::uint64_t> boundary;
+    std::vector<std::uint32_t> frontier;
+    for (std::uint32_t i : members) {
+      const std::uint32_t other = label[i] == ca ? cb : ca;
+      bool on = false;
+      for (std::uint32_t j : g.neighbours_of(i)) {
+        std::uint32_t a, b;
+        if (label[j] == other && detail::shared_edge(tri[i], tri[j], a, b)) {
+          if (label[i] == ca) boundary.push_back(detail::edge_key(a, b));
+          on = true;
+        }
+      }
+      if (on) frontier.push_back(i);
+    }
+    std::sort(boundary.begin(), boundary.end());
+    boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+    std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
+    {
+      std::vector<std::uint32_t> ends;
+      for (auto e : boundary) {
+        ends.push_back(static_cast<std::uint32_t>(e >> 32));
+        ends.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
+      }
+      std::sort(ends.begin(), ends.end());
+      for (std::size_t i = 0; i < ends.size();) {
+        std::size_t j = i;
+        while (j < ends.size() && ends[j] == ends[i]) ++j;
+        degree.emplace_back(ends[i], static_cast<int>(j - i));
+        i = j;
+      }
+    }
+    std::vector<std::uint32_t> endpoints;
+    bool simple = degree.size() == boundary.size() + 1;
+    for (const auto& [v, d] : degree) {
+      if (d == 1) endpoints.push_back(v);
+      else if (d != 2) simple = false;
+    }
+    if (!simple || endpoints.size() != 2) continue;
+
+    // 2. The band.
+    const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
+    auto prefers_other = [&](std::uint32_t i) {
+      const std::uint32_t c = s.class_of(i);
+      if (stamp[c] != pair_index) {
+        stamp[c] = pair_index;
+        js_a[c] = s.divergence(c, seed_a);
+        js_b[c] = s.divergence(c, seed_b);
+      }
+      return label[i] == ca ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
+    };
+    std::vector<std::uint8_t> in_band(n, 0);
+    std::vector<std::uint32_t> band;
+    for (std::uint32_t i : frontier)
+      if (prefers_other(i)) {
+        in_band[i] = 1;
+        band.push_back(i);
+      }
+    for (std::size_t q = 0; q < band.size(); ++q)
+      for (std::uint32_t j : g.neighbours_of(band[q]))
+        if (!in_band[j] && label[j] == label[band[q]] && prefers_other(j)) {
+          in_band[j] = 1;
+          band.push_back(j);
+        }
+    std::vector<std::uint64_t> edges(boundary);
+    for (std::uint32_t i : band)
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t a = tri[i][c], b = tri[i][(c + 1) % 3];
+        int across = 0;
+        bool inside = true;
+        for (std::uint32_t j : g.neighbours_of(i)) {
+          std::uint32_t x, y;
+          if (detail::shared_edge(tri[i], tri[j], x, y) && detail::edge_key(x, y) == detail::edge_key(a, b)) {
+            ++across;
+            inside = inside && (label[j] == ca || label[j] == cb);
+          }
+        }
+        if (across == 1 && inside) edges.push_back(detail::edge_key(a, b));
+      }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    if (edges.size() == boundary.size()) continue;  // nothing to choose from
+
+    // 3. A* between the end vertices over the band edges.
+    std::vector<std::uint32_t> verts;
+    for (auto e : edges) {
+      verts.push_back(static_cast<std::uint32_t>(e >> 32));
+      verts.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
+    }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    auto vid = [&](std::uint32_t v) {
+      return static_cast<std::uint32_t>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
+    };
+    std::vector<std::vector<std::uint32_t>> adj(verts.size());
+    for (auto e : edges) {
+      const std::uint32_t a = vid(static_cast<std::uint32_t>(e >> 32)), b = vid(static_cast<std::uint32_t>(e & 0xffffffffu));
+      adj[a].push_back(b);
+      adj[b].push_back(a);
+    }
+    std::vector<glm::dvec3> pos(verts.size());
+    for (std::size_t i = 0; i < verts.size(); ++i) pos[i] = glm::dvec3(mesh_position(m, verts[i]));
+    const std::uint32_t start = vid(endpoints[0]), goal = vid(endpoints[1]);
+    std::vector<double> dist(verts.size(), std::numeric_limits<double>::infinity());
+    std::vector<std::uint32_t> from(verts.size(), invalid_id);
+    using item = std::pair<double, std::uint32_t>;
+    std::priority_queue<item, std::vector<item>, std::greater<item>> open;
+    dist[start] = 0.0;
+    open.emplace(glm::distance(pos[start], pos[goal]), start);
+    while (!open.empty()) {
+      const auto [f, v] = open.top();
+      open.pop();
+      if (v == goal) break;
+      if (f > dist[v] + glm::distance(pos[v], pos[goal])) continue;  // stale entry
+      for (std::uint32_t w : adj[v]) {
+        const double d = dist[v] + glm::distance(pos[v], pos[w]);
+        if (d < dist[w]) {
+          dist[w] = d;
+          from[w] = v;
+          open.emplace(d + glm::distance(pos[w], pos[goal]), w);
+        }
+      }
+    }
+    if (from[goal] == invalid_id) continue;
+    std::vector<std::uint64_t> path;
+    for (std::uint32_t v = goal; v != start; v = from[v]) path.push_back(detail::edge_key(verts[v], verts[from[v]]));
+    std::sort(path.begin(), path.end());
+    if (path == boundary) continue;
+
+    // 4. Split A ∪ B along the path.
+    std::uint32_t regions = 0;
+    for (std::uint32_t i : members) {
+      if (region[i] != invalid_id) continue;
+      region[i] = regions;
+      stack.push_back(i);
+      while (!stack.empty()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
+        for (std::uint32_t j : g.neighbours_of(t)) {
+          if (region[j] != invalid_id || (label[j] != ca && label[j] != cb)) continue;
+          std::uint32_t a, b;
+          if (detail::shared_edge(tri[t], tri[j], a, b) && std::binary_search(path.begin(), path.end(), detail::edge_key(a, b)))
+            continue;
+          region[j] = regions;
+          stack.push_back(j);
+        }
+      }
+      ++regions;
+    }
+    const std::uint32_t ra = region[r.seeds[ca]], rb = region[r.seeds[cb]];
+    if (regions == 2 && ra != rb) {
+      for (std::uint32_t i : members) {
+        const std::uint32_t want = region[i] == ra ? ca : cb;
+        if (label[i] != want) {
+          label[i] = want;
+          ++moved;
+        }
+      }
+      members_of[ca].clear();
+      members_of[cb].clear();
+      for (std::uint32_t i : members) members_of[label[i]].push_back(i);
+    }
+    for (std::uint32_t i : members) region[i] = invalid_id;
+  }
+  return moved;
+}
+
+}  // namespace infolerp

@@ -1,0 +1,166 @@
+#pragma once
+// Information channels for clustering (clustering paper §3.1: input distribution p(X),
+// transition rows p(Y|x), output distribution p(Y) by Eq. (1), per-element mutual information
+// I(x;Y), and the similarity JS(Y|a,b) between two elements).
+//
+// Two layers, both concepts any user type can model:
+//   channel_state  a channel initialised on one set of M elements (the triangles of one
+//                  cluster, Algorithm 1's ch.init(cl)). Elements are grouped into classes:
+//                  elements of one class have identical rows and input probability, so every
+//                  divergence is asked per class (a planar patch is one class, a binned normal
+//                  histogram has at most K). The simplest model is class_of(i) == i.
+//   channel        what cluster_mesh receives: a `threshold` in [0,1] and
+//                  init(span of triangle ids) -> result<channel_state>. A channel may also offer
+//                  prepare(mesh, topology, tracer, executor) -> result<prepared channel>, run once
+//                  per mesh before Algorithm 1 (normals, stretch, ray-traced visibility), and
+//                  skip_reason() -> const char* (nullptr = active) to say it does not apply.
+//
+// Direct channels (T→T, §3.1.2–3.1.3) never build the M×M matrix: their rows are aggregated per
+// class with direct_channel_state below.
+#include <algorithm>
+#include <cmath>
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <type_traits>
+#include <utility>
+#include <vector>
+#include "infolerp/core/status.hpp"
+#include "infolerp/info/entropy.hpp"
+#include "infolerp/info/jensen_shannon.hpp"
+
+namespace infolerp {
+
+// A channel initialised on M elements (local ids 0..M-1) grouped into U classes.
+//   element_count() -> M, class_count() -> U (1 <= U <= M when M > 0)
+//   class_of(i) -> class of element i (< U)
+//   mutual_information(c) -> I(x;Y) in bits for an element x of class c
+//   divergence(a, b) -> JS(Y|a,b) in [0,1] between elements of classes a and b (symmetric, 0 for a == b)
+// Optional, used when present:
+//   divergences(a, first, out) -> out[i] = divergence(a, first + i), a batch that may share work
+//   all_alike() -> bool: every row is identical (the clustering then skips all work)
+// Thread-safety: const members are called concurrently from the executor's threads.
+template <class S>
+concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {
+  { s.element_count() } -> std::convertible_to<std::size_t>;
+  { s.class_count() } -> std::convertible_to<std::size_t>;
+  { s.class_of(a) } -> std::convertible_to<std::uint32_t>;
+  { s.mutual_information(a) } -> std::convertible_to<double>;
+  { s.divergence(a, b) } -> std::convertible_to<double>;
+};
+
+namespace detail {
+template <class R> struct result_value {};
+template <class T> struct result_value<result<T>> { using type = T; };
+template <class R> using result_value_t = typename result_value<std::remove_cvref_t<R>>::type;
+}  // namespace detail
+
+// A channel ready to initialise on sets of triangles (global triangle ids).
+template <class C>
+concept channel = requires(const C& c, std::span<const std::uint32_t> triangles) {
+  { c.threshold } -> std::convertible_to<double>;
+  { c.init(triangles) };
+  requires channel_state<detail::result_value_t<decltype(c.init(triangles))>>;
+};
+
+// The state type a channel's init produces.
+template <channel C>
+using channel_state_of = detail::result_value_t<decltype(std::declval<const C&>().init(
+    std::declval<std::span<const std::uint32_t>>()))>;
+
+// Checks a clustering threshold: finite and in [0, 1]. `what` names the channel in the message.
+inline status check_threshold(double threshold, const char* what) {
+  if (!(threshold >= 0.0 && threshold <= 1.0))  // also rejects NaN
+    return make_error(errc::bad_parameter, no_element, what, ": threshold ", threshold,
+                      " outside [0, 1] (or NaN)");
+  return {};
+}
+
+// The paper's membership test "JS < Th", with Th = 1 meaning "everything is alike" (JS can reach
+// exactly 1 for disjoint rows, and the paper wants Th = 1 to give one cluster).
+inline bool is_similar(double js, double threshold) noexcept { return threshold >= 1.0 || js < threshold; }
+
+// A direct channel (T→T) aggregated over classes. The row of an element of class a over the M
+// elements is constant inside each class c, so it is stored per class as
+//   row_a(c) = mass(a, c) / Σ_c' mass(a, c')      (mass = summed kernel over c's elements)
+// and JS over the M-entry rows equals js_divergence over these U-entry rows exactly (each JS
+// term is homogeneous in the entry). Input probabilities are uniform (1/M), so JS weights are ½.
+// A row whose masses are all 0 (e.g. a planar patch under orientation: 1 − n·n' = 0
+// everywhere) is taken as uniform over the elements, so all such rows are alike.
+//
+// Kernel requirements: class_count(), count(c) (elements in class c, as double),
+//   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
+// Allocation: O(U) at construction; divergence() allocates 2U doubles per call, divergences()
+// once per call. Thread-safe for concurrent const calls.
+template <class Kernel>
+class direct_channel_state {
+ public:
+  direct_channel_state(std::vector<std::uint32_t> class_of, Kernel kernel)
+      : class_of_(std::move(class_of)), kernel_(std::move(kernel)) {
+    const std::size_t u = kernel_.class_count();
+    output_.assign(u, 0.0);
+    std::vector<double> r(u);
+    const double m = static_cast<double>(class_of_.size());
+    // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U²).
+    for (std::uint32_t a = 0; a < u; ++a) {
+      row(a, r);
+      const double w = kernel_.count(a) / m;
+      for (std::size_t c = 0; c < u; ++c) output_[c] += w * r[c];
+    }
+  }
+
+  std::size_t element_count() const { return class_of_.size(); }
+  std::size_t class_count() const { return kernel_.class_count(); }
+  std::uint32_t class_of(std::uint32_t i) const { return class_of_[i]; }
+  bool all_alike() const { return class_count() <= 1; }
+  const Kernel& kernel() const { return kernel_; }
+  std::span<const double> output_distribution() const { return output_; }
+
+  // p(Y|a) aggregated per class. Preconditions: out.size() == class_count(). O(U), no allocation.
+  void row(std::uint32_t a, std::span<double> out) const {
+    const double total = kernel_.total(a);
+    const double m = static_cast<double>(class_of_.size());
+    if (total > 0.0) {
+      for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = kernel_.mass(a, c) / total;
+    } else {
+      for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = kernel_.count(c) / m;
+    }
+  }
+
+  double mutual_information(std::uint32_t a) const {
+    std::vector<double> r(class_count());
+    row(a, r);
+    return element_mutual_information(r, output_);
+  }
+
+  double divergence(std::uint32_t a, std::uint32_t b) const {
+    if (a == b) return 0.0;
+    std::vector<double> ra(class_count()), rb(class_count());
+    row(a, ra);
+    row(b, rb);
+    return js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5);
+  }
+
+  // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
+  void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
+    std::vector<double> ra(class_count()), rb(class_count());
+    row(a, ra);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const auto b = static_cast<std::uint32_t>(first + i);
+      if (b == a) {
+        out[i] = 0.0f;
+        continue;
+      }
+      row(b, rb);
+      out[i] = static_cast<float>(js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5));
+    }
+  }
+
+ private:
+  std::vector<std::uint32_t> class_of_;
+  Kernel kernel_;
+  std::vector<double> output_;
+};
+
+}  // namespace infolerp

@@ -1,0 +1,333 @@
+#pragma once
+// Clustering one channel (clustering paper §3.2): seeds (§3.2.2), parallel growth from the seeds
+// one ring at a time and sequential clustering of what is left (§3.2.3), merging of small
+// clusters (§3.2.4). Works on any channel_state (channel.hpp) over a set of elements joined by an
+// element_graph (the dual graph of a triangle set).
+//
+// Rules pinned down here:
+//   membership   JS(t, seed) < Th, and Th = 1 accepts everything (is_similar).
+//   Th = 0       every element is its own cluster (no growth, no merging).
+//   Th = 1, or all rows alike   one cluster per connected component, no divergence evaluated.
+//   seeds        first: the class with minimum I(x;Y); next: the class with maximum summed JS
+//                to the seeds so far among those with JS > Th to every seed; stop when none.
+//                Each seed's JS column (all classes) is computed once, in parallel.
+//   growth       all seeds grow together ring by ring; an element claimed by several seeds in
+//                one ring joins the one with the smallest JS, then the smallest seed index.
+//   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
+//   merging      clusters with fewer than min_cluster_fraction·M elements join the neighbouring
+//                cluster whose seed has the smallest JS to theirs (ties: smallest id), in passes
+//                (smallest first) until none can merge. Isolated small clusters stay.
+//   numbering    clusters are numbered by their smallest element.
+// Every cluster is connected in the graph; results are identical for any executor.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <span>
+#include <type_traits>
+#include <vector>
+#include "infolerp/cluster/channel.hpp"
+#include "infolerp/core/executor.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/mesh/topology.hpp"
+
+namespace infolerp {
+
+// Adjacency over local element ids (CSR).
+struct element_graph {
+  std::vector<std::uint32_t> offsets{0};
+  std::vector<std::uint32_t> neighbours;
+  std::size_t size() const { return offsets.size() - 1; }
+  std::span<const std::uint32_t> neighbours_of(std::size_t i) const {
+    return {neighbours.data() + offsets[i], neighbours.data() + offsets[i + 1]};
+  }
+};
+
+// The dual graph restricted to `triangles` (local id = position in the span).
+// `scratch` must hold topo.triangle_count() entries equal to invalid_id; it is restored.
+// Preconditions: ids distinct and in range. O(M), allocation O(M).
+inline element_graph subset_graph(const mesh_topology& topo, std::span<const std::uint32_t> triangles,
+                                  std::vector<std::uint32_t>& scratch) {
+  for (std::size_t i = 0; i < triangles.size(); ++i) scratch[triangles[i]] = static_cast<std::uint32_t>(i);
+  element_graph g;
+  g.offsets.resize(triangles.size() + 1);
+  g.neighbours.reserve(3 * triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    for (std::uint32_t n : topo.neighbours_of(triangles[i]))
+      if (scratch[n] != invalid_id) g.neighbours.push_back(scratch[n]);
+    g.offsets[i + 1] = static_cast<std::uint32_t>(g.neighbours.size());
+  }
+  for (std::uint32_t t : triangles) scratch[t] = invalid_id;
+  return g;
+}
+
+struct region_growing_options {
+  double threshold = 0.1;               // JS threshold Th in [0,1]
+  double min_cluster_fraction = 0.001;  // §3.2.4: smaller clusters merge into a neighbour (0 = never)
+  std::size_t grain = 32;               // classes per parallel task when evaluating JS columns
+};
+
+struct region_growing_result {
+  std::vector<std::uint32_t> cluster_of;  // per element, 0..cluster_count()-1
+  std::vector<std::uint32_t> seeds;       // per cluster: its seed element
+  std::uint32_t parallel_seeds = 0;       // seeds chosen by §3.2.2
+  std::uint32_t sequential_seeds = 0;     // clusters started by the sequential pass
+  std::uint32_t merged = 0;               // clusters merged away by §3.2.4
+  bool all_alike = false;                 // every row was alike: no work done
+  std::uint32_t cluster_count() const { return static_cast<std::uint32_t>(seeds.size()); }
+};
+
+namespace detail {
+
+// out[c] = JS(a, c) for every class c, in parallel chunks (each slot independent).
+template <class S, class E>
+void js_column(const S& s, std::uint32_t a, std::span<float> out, std::size_t grain, E& exec) {
+  for_each_chunk(exec, out.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
+    if constexpr (requires { s.divergences(a, std::uint32_t{}, out.subspan(b, e - b)); }) {
+      s.divergences(a, static_cast<std::uint32_t>(b), out.subspan(b, e - b));
+    } else {
+      for (std::size_t c = b; c < e; ++c) out[c] = static_cast<float>(s.divergence(a, static_cast<std::uint32_t>(c)));
+    }
+  });
+}
+
+// Renumbers clusters by their smallest element and drops empty ids; seeds follow.
+inline void canonical_numbering(std::vector<std::uint32_t>& label, std::vector<std::uint32_t>& seeds) {
+  std::vector<std::uint32_t> map(seeds.size(), invalid_id), new_seeds;
+  for (auto& l : label) {
+    if (map[l] == invalid_id) {
+      map[l] = static_cast<std::uint32_t>(new_seeds.size());
+      new_seeds.push_back(seeds[l]);
+    }
+    l = map[l];
+  }
+  seeds = std::move(new_seeds);
+}
+
+// One cluster per connected component, seeded at its smallest element.
+inline void component_clusters(const element_graph& g, region_growing_result& r) {
+  const std::size_t m = g.size();
+  r.cluster_of.assign(m, invalid_id);
+  std::vector<std::uint32_t> stack;
+  for (std::uint32_t e = 0; e < m; ++e) {
+    if (r.cluster_of[e] != invalid_id) continue;
+    const auto k = static_cast<std::uint32_t>(r.seeds.size());
+    r.seeds.push_back(e);
+    r.cluster_of[e] = k;
+    stack.push_back(e);
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      for (std::uint32_t n : g.neighbours_of(t))
+        if (r.cluster_of[n] == invalid_id) {
+          r.cluster_of[n] = k;
+          stack.push_back(n);
+        }
+    }
+  }
+}
+
+}  // namespace detail
+
+// §3.2.2 seed selection. Returns the seed classes in order; `columns[k]` receives seed k's JS to
+// every class. Preconditions: 0 < threshold < 1, class_count() >= 1.
+// Complexity: U MI evaluations + one JS column (U divergences) per seed. Allocation U floats per seed.
+template <class S, class E>
+std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_t grain, E& exec,
+                                        std::vector<std::vector<float>>& columns) {
+  static_assert(channel_state<S>);
+  const std::size_t u = s.class_count();
+  std::vector<double> mi(u);
+  for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information(static_cast<std::uint32_t>(c));
+  });
+  std::uint32_t next = 0;
+  for (std::uint32_t c = 1; c < u; ++c)
+    if (mi[c] < mi[next]) next = c;
+  std::vector<std::uint32_t> seeds;
+  std::vector<double> sum(u, 0.0);
+  std::vector<float> min_js(u, std::numeric_limits<float>::infinity());
+  columns.clear();
+  for (;;) {
+    seeds.push_back(next);
+    columns.emplace_back(u);
+    detail::js_column(s, next, std::span<float>(columns.back()), grain, exec);
+    const auto& col = columns.back();
+    std::uint32_t best = invalid_id;
+    for (std::uint32_t c = 0; c < u; ++c) {
+      sum[c] += col[c];
+      min_js[c] = std::min(min_js[c], col[c]);
+      if (static_cast<double>(min_js[c]) > threshold && (best == invalid_id || sum[c] > sum[best])) best = c;
+    }
+    if (best == invalid_id) break;
+    next = best;
+  }
+  return seeds;
+}
+
+// §3.2 for one channel on one set: seeds, parallel growth, sequential pass, merging.
+// Errors: threshold or min_cluster_fraction outside [0,1] or NaN, graph/state size mismatch,
+// empty set. Complexity: dominated by the JS columns of the seeds (see select_seeds), plus
+// O(M·degree) for growth and O(M·degree) per merging pass. Allocation O(M + seeds·U).
+// Thread-safety: the state's const members are called from the executor's threads.
+template <class S, class E>
+result<region_growing_result> grow_regions(const S& s, const element_graph& g, const region_growing_options& o,
+                                           E&& exec) {
+  static_assert(channel_state<S>, "infolerp: grow_regions needs a channel_state (see cluster/channel.hpp)");
+  static_assert(check_executor<std::remove_cvref_t<E>>());
+  if (status st = check_threshold(o.threshold, "region growing"); !st) return st;
+  if (!(o.min_cluster_fraction >= 0.0 && o.min_cluster_fraction <= 1.0))
+    return make_error(errc::bad_parameter, no_element, "region growing: min_cluster_fraction ", o.min_cluster_fraction,
+                      " outside [0, 1]");
+  const std::size_t m = s.element_count();
+  if (m == 0) return make_error(errc::empty_input, no_element, "region growing: empty element set");
+  if (g.size() != m)
+    return make_error(errc::bad_size, no_element, "region growing: graph has ", g.size(), " elements, channel ", m);
+  const double th = o.threshold;
+  region_growing_result r;
+  if (th == 0.0) {  // one cluster per element
+    r.cluster_of.resize(m);
+    std::iota(r.cluster_of.begin(), r.cluster_of.end(), 0u);
+    r.seeds = r.cluster_of;
+    r.sequential_seeds = static_cast<std::uint32_t>(m);
+    return r;
+  }
+  bool alike = s.class_count() <= 1;
+  if constexpr (requires { { s.all_alike() } -> std::convertible_to<bool>; }) alike = alike || s.all_alike();
+  if (alike || th >= 1.0) {
+    r.all_alike = alike;
+    detail::component_clusters(g, r);
+    return r;
+  }
+
+  const std::size_t u = s.class_count();
+  std::vector<std::uint32_t> cls(m), first_of(u, invalid_id);
+  for (std::uint32_t e = 0; e < m; ++e) {
+    cls[e] = s.class_of(e);
+    if (first_of[cls[e]] == invalid_id) first_of[cls[e]] = e;
+  }
+  std::vector<std::vector<float>> columns;
+  const std::vector<std::uint32_t> seed_classes = select_seeds(s, th, o.grain, exec, columns);
+  const std::size_t k0 = seed_classes.size();
+  r.parallel_seeds = static_cast<std::uint32_t>(k0);
+
+  // Parallel growth, ring by ring.
+  std::vector<std::uint32_t>& label = r.cluster_of;
+  label.assign(m, invalid_id);
+  std::vector<std::vector<std::uint32_t>> frontier(k0);
+  for (std::uint32_t k = 0; k < k0; ++k) {
+    const std::uint32_t e = first_of[seed_classes[k]];
+    r.seeds.push_back(e);
+    label[e] = k;
+    frontier[k].push_back(e);
+  }
+  std::vector<float> best_js(m, std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> best_k(m, invalid_id), touched;
+  for (bool any = true; any;) {
+    touched.clear();
+    for (std::uint32_t k = 0; k < k0; ++k)
+      for (std::uint32_t f : frontier[k])
+        for (std::uint32_t n : g.neighbours_of(f)) {
+          if (label[n] != invalid_id) continue;
+          const float js = columns[k][cls[n]];
+          if (!is_similar(js, th)) continue;
+          if (best_k[n] == invalid_id) touched.push_back(n);
+          if (js < best_js[n] || (js == best_js[n] && k < best_k[n])) {
+            best_js[n] = js;
+            best_k[n] = k;
+          }
+        }
+    for (auto& f : frontier) f.clear();
+    for (std::uint32_t n : touched) {
+      label[n] = best_k[n];
+      frontier[best_k[n]].push_back(n);
+      best_k[n] = invalid_id;
+      best_js[n] = std::numeric_limits<float>::infinity();
+    }
+    any = !touched.empty();
+  }
+  columns.clear();
+  columns.shrink_to_fit();
+
+  // Sequential pass over leftovers; JS to the current seed memoised per class (stamped).
+  std::vector<float> memo(u);
+  std::vector<std::uint32_t> stamp(u, invalid_id), queue;
+  for (std::uint32_t e = 0; e < m; ++e) {
+    if (label[e] != invalid_id) continue;
+    const auto k = static_cast<std::uint32_t>(r.seeds.size());
+    r.seeds.push_back(e);
+    ++r.sequential_seeds;
+    label[e] = k;
+    queue.assign(1, e);
+    const std::uint32_t sc = cls[e];
+    for (std::size_t q = 0; q < queue.size(); ++q)
+      for (std::uint32_t n : g.neighbours_of(queue[q])) {
+        if (label[n] != invalid_id) continue;
+        if (stamp[cls[n]] != k) {
+          stamp[cls[n]] = k;
+          memo[cls[n]] = static_cast<float>(s.divergence(sc, cls[n]));
+        }
+        if (!is_similar(memo[cls[n]], th)) continue;
+        label[n] = k;
+        queue.push_back(n);
+      }
+  }
+
+  // §3.2.4 merging, in passes.
+  const double min_size = o.min_cluster_fraction * static_cast<double>(m);
+  for (bool changed = true; changed && min_size > 1.0;) {
+    changed = false;
+    const std::size_t kc = r.seeds.size();
+    std::vector<double> size(kc, 0.0);
+    for (std::uint32_t l : label) size[l] += 1.0;
+    std::vector<std::uint32_t> small;
+    for (std::uint32_t k = 0; k < kc; ++k)
+      if (size[k] < min_size) small.push_back(k);
+    if (small.empty()) break;
+    // Neighbouring clusters of each small cluster.
+    std::vector<std::uint32_t> is_small(kc, invalid_id);
+    for (std::uint32_t i = 0; i < small.size(); ++i) is_small[small[i]] = i;
+    std::vector<std::vector<std::uint32_t>> adj(small.size());
+    for (std::uint32_t e = 0; e < m; ++e) {
+      const std::uint32_t si = is_small[label[e]];
+      if (si == invalid_id) continue;
+      for (std::uint32_t n : g.neighbours_of(e))
+        if (label[n] != label[e]) adj[si].push_back(label[n]);
+    }
+    std::vector<std::uint32_t> parent(kc);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    std::vector<std::uint32_t> order(small.begin(), small.end());
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] < size[b]; });
+    for (std::uint32_t a : order) {
+      if (find(a) != a || size[a] >= min_size) continue;
+      std::uint32_t best = invalid_id;
+      double best_d = 0.0;
+      for (std::uint32_t nb : adj[is_small[a]]) {
+        const std::uint32_t b = find(nb);
+        if (b == a) continue;
+        const double d = s.divergence(cls[r.seeds[a]], cls[r.seeds[b]]);
+        if (best == invalid_id || d < best_d || (d == best_d && b < best)) {
+          best = b;
+          best_d = d;
+        }
+      }
+      if (best == invalid_id) continue;
+      parent[a] = best;
+      size[best] += size[a];
+      ++r.merged;
+      changed = true;
+    }
+    for (auto& l : label) l = find(l);
+    detail::canonical_numbering(label, r.seeds);
+  }
+  detail::canonical_numbering(label, r.seeds);
+  return r;
+}
+
+}  // namespace infolerp

@@ -1,0 +1,302 @@
+#pragma once
+// Visibility channel (clustering paper §3.1.1, the viewpoint channel of Feixas et al. [32]):
+// an indirect channel V→T measured through the user's tracer, then inverted to T→V by Bayes.
+//
+//   viewpoints   N points spread uniformly (Fibonacci lattice) on a sphere around the mesh's
+//                bounding box (radius = radius_scale × half its diagonal), p(v) = 1/N.
+//   OR(t, v)     occlusion ratio: the fraction of n² stratified sample points of t (centroids of
+//                t's regular n×n subdivision) from which an occlusion ray toward v is free.
+//                Back-facing (n_t·(v − x) <= 0) counts as not visible (OR = 0). Ratios are
+//                per triangle area, so the channel is independent of the triangulation.
+//   p(t|v) = OR(t,v) / Σ_t' OR(t',v) over the set being clustered, p(t) = Σ_v p(v) p(t|v),
+//   p(v|t) = p(v) p(t|v) / p(t)   (Bayes), JS(Y|a,b) weighted by p(a), p(b).
+// Viewpoints that see nothing of the set are dropped (p(v) = 1/N_active).
+// Triangles seen from no viewpoint (p(t) = 0, e.g. inside a closed cavity) form their own
+// class: JS between two of them is 0, between one of them and a seen triangle 1, and their
+// I(t;V) is +inf so they are never the first seed.
+// Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
+// its edge neighbours in the set with JS <= Th.
+//
+// Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
+// overload when it has one), chunks of `grain` triangles in parallel through the executor.
+// OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
+// its own rays.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <span>
+#include <utility>
+#include <vector>
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include "infolerp/cluster/channel.hpp"
+#include "infolerp/core/executor.hpp"
+#include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/tracer.hpp"
+#include "infolerp/info/entropy.hpp"
+#include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/mesh/geometry.hpp"
+#include "infolerp/mesh/topology.hpp"
+
+namespace infolerp {
+
+// n points on a sphere by the Fibonacci lattice (near-uniform, deterministic). O(n).
+inline std::vector<glm::dvec3> fibonacci_sphere(std::size_t n, glm::dvec3 center, double radius) {
+  std::vector<glm::dvec3> out(n);
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * static_cast<double>(i) + 1.0) / static_cast<double>(n);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden * static_cast<double>(i);
+    out[i] = center + radius * glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  return out;
+}
+
+// Barycentric weights (w1, w2) of the centroids of a triangle's regular n×n subdivision
+// (n² stratified samples; the point is (1-w1-w2)p0 + w1 p1 + w2 p2). O(n²).
+inline std::vector<glm::dvec2> stratified_triangle_samples(std::uint32_t n) {
+  std::vector<glm::dvec2> out;
+  const double inv = 1.0 / static_cast<double>(n);
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = 0; i + j < n; ++j) {
+      out.emplace_back((i + 1.0 / 3.0) * inv, (j + 1.0 / 3.0) * inv);
+      if (i + j + 2 <= n) out.emplace_back((i + 2.0 / 3.0) * inv, (j + 2.0 / 3.0) * inv);
+    }
+  return out;
+}
+
+struct visibility_channel;
+
+// The viewpoints and sample pattern of one visibility measurement.
+struct visibility_setup {
+  std::vector<glm::dvec3> viewpoints;
+  std::vector<glm::dvec2> samples;  // barycentric (w1, w2)
+  double offset = 0.0;              // ray origins are lifted by this along the face normal
+};
+
+// Appends the occlusion rays of triangles [first, last) to `rays`, and for each ray its slot
+// (t − first)·N + v to `slots`. Back-facing sample/viewpoint pairs get no ray (OR term 0).
+// Exposed so that benchmarks can time the same rays alone. O((last − first)·N·n²).
+template <class M>
+void make_visibility_rays(const M& m, const visibility_setup& setup, std::size_t first, std::size_t last,
+                          std::vector<ray>& rays, std::vector<std::uint32_t>& slots) {
+  static_assert(check_mesh<M>());
+  const std::size_t nv = setup.viewpoints.size();
+  for (std::size_t t = first; t < last; ++t) {
+    const triangle_corners c = corners(m, t);
+    const glm::dvec3 n = glm::dvec3(triangle_normal(c));
+    if (n == glm::dvec3(0.0)) continue;
+    for (const glm::dvec2& w : setup.samples) {
+      const glm::dvec3 x = (1.0 - w.x - w.y) * c.p0 + w.x * c.p1 + w.y * c.p2 + setup.offset * n;
+      for (std::size_t v = 0; v < nv; ++v) {
+        const glm::dvec3 d = setup.viewpoints[v] - x;
+        if (glm::dot(n, d) <= 0.0) continue;  // back-facing
+        rays.push_back(ray{glm::vec3(x), 0.0f, glm::vec3(d), 1.0f});
+        slots.push_back(static_cast<std::uint32_t>((t - first) * nv + v));
+      }
+    }
+  }
+}
+
+// A visibility channel initialised on a set of triangles. Classes are elements.
+class visibility_state {
+ public:
+  std::size_t element_count() const { return p_.size(); }
+  std::size_t class_count() const { return p_.size(); }
+  std::uint32_t class_of(std::uint32_t i) const { return i; }
+  bool all_alike() const { return all_alike_; }
+  std::size_t viewpoint_count() const { return n_; }
+  // p(V|t) (zeros when t is unseen) and p(t).
+  std::span<const float> row(std::uint32_t t) const { return {rows_.data() + std::size_t{t} * n_, n_}; }
+  double input_probability(std::uint32_t t) const { return p_[t]; }
+  bool unseen(std::uint32_t t) const { return !(p_[t] > 0.0); }
+
+  double divergence(std::uint32_t a, std::uint32_t b) const {
+    if (a == b) return 0.0;
+    const bool ua = unseen(a), ub = unseen(b);
+    if (ua || ub) return ua == ub ? 0.0 : 1.0;
+    return js_channel(row(a), row(b), p_[a], p_[b]);
+  }
+  double mutual_information(std::uint32_t t) const {
+    if (unseen(t)) return std::numeric_limits<double>::infinity();
+    const auto r = row(t);
+    std::vector<double> d(r.begin(), r.end());
+    return element_mutual_information(d, output_);
+  }
+
+ private:
+  friend struct prepared_visibility_channel;
+  std::size_t n_ = 0;
+  std::vector<float> rows_;     // M × N
+  std::vector<double> p_;       // p(t)
+  std::vector<double> output_;  // p(v)
+  bool all_alike_ = false;
+};
+
+// Visibility measured once for a mesh: visible-sample counts per (triangle, viewpoint).
+struct prepared_visibility_channel {
+  double threshold = 0.48;
+  bool denoise = true;
+  std::size_t viewpoints = 0;
+  std::uint32_t samples = 0;           // n² per triangle
+  std::vector<std::uint8_t> visible;   // T × N: samples with a free ray toward v
+  std::vector<std::uint32_t> neighbour_offsets, neighbours;  // the mesh's dual graph
+
+  // OR(t, v) in [0, 1].
+  double occlusion_ratio(std::size_t t, std::size_t v) const {
+    return static_cast<double>(visible[t * viewpoints + v]) / static_cast<double>(samples);
+  }
+
+  // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
+  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising,
+  // + O(M log M) to find neighbours in the set). Allocation O(M·N) floats.
+  result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
+    const std::size_t m = triangles.size(), n = viewpoints;
+    if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
+    const std::size_t nt = neighbour_offsets.empty() ? 0 : neighbour_offsets.size() - 1;
+    for (std::uint32_t t : triangles)
+      if (t >= nt) return make_error(errc::index_out_of_range, t, "visibility channel: triangle ", t, " out of range");
+    std::vector<double> weight(n, 0.0);  // Σ_t OR(t, v)
+    for (std::uint32_t t : triangles)
+      for (std::size_t v = 0; v < n; ++v) weight[v] += occlusion_ratio(t, v);
+    std::size_t active = 0;
+    for (double w : weight) active += w > 0.0 ? 1 : 0;
+    visibility_state s;
+    s.n_ = n;
+    s.rows_.assign(m * n, 0.0f);
+    s.p_.assign(m, 0.0);
+    s.output_.assign(n, 0.0);
+    if (active == 0) {  // nothing of the set is seen from anywhere: one class, all alike
+      s.all_alike_ = true;
+      return s;
+    }
+    const double pv = 1.0 / static_cast<double>(active);
+    for (std::size_t v = 0; v < n; ++v) s.output_[v] = weight[v] > 0.0 ? pv : 0.0;
+    std::vector<double> ptv(n);
+    for (std::size_t i = 0; i < m; ++i) {
+      double pt = 0.0;
+      for (std::size_t v = 0; v < n; ++v) {
+        ptv[v] = weight[v] > 0.0 ? occlusion_ratio(triangles[i], v) / weight[v] : 0.0;
+        pt += pv * ptv[v];
+      }
+      s.p_[i] = pt;
+      if (pt > 0.0)
+        for (std::size_t v = 0; v < n; ++v) s.rows_[i * n + v] = static_cast<float>(pv * ptv[v] / pt);
+    }
+    if (denoise && threshold > 0.0) denoise_rows(triangles, s);
+    s.all_alike_ = true;
+    for (std::size_t i = 1; i < m && s.all_alike_; ++i)
+      s.all_alike_ = s.p_[i] == s.p_[0] &&
+                     std::equal(s.rows_.begin() + static_cast<std::ptrdiff_t>(i * n),
+                                s.rows_.begin() + static_cast<std::ptrdiff_t>((i + 1) * n), s.rows_.begin());
+    return s;
+  }
+
+ private:
+  // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th}.
+  void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s) const {
+    const std::size_t m = triangles.size(), n = viewpoints;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> local(m);  // (global, local), sorted
+    for (std::size_t i = 0; i < m; ++i) local[i] = {triangles[i], static_cast<std::uint32_t>(i)};
+    std::sort(local.begin(), local.end());
+    std::vector<float> out(s.rows_);
+    std::vector<double> acc(n);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (s.unseen(static_cast<std::uint32_t>(i))) continue;
+      std::fill(acc.begin(), acc.end(), 0.0);
+      std::size_t count = 0;
+      auto add = [&](std::size_t j) {
+        for (std::size_t v = 0; v < n; ++v) acc[v] += s.rows_[j * n + v];
+        ++count;
+      };
+      add(i);
+      const std::uint32_t g = triangles[i];
+      for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
+        const auto it = std::lower_bound(local.begin(), local.end(), std::pair{neighbours[k], 0u});
+        if (it == local.end() || it->first != neighbours[k]) continue;
+        const std::uint32_t j = it->second;
+        if (s.unseen(j)) continue;
+        if (s.divergence(static_cast<std::uint32_t>(i), j) <= threshold) add(j);
+      }
+      for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
+    }
+    s.rows_ = std::move(out);
+  }
+};
+
+struct visibility_channel {
+  double threshold = 0.48;             // JS threshold Th in [0,1]
+  std::uint32_t viewpoints = 64;       // N viewpoints on the bounding sphere (>= 1)
+  std::uint32_t samples_per_side = 2;  // n: n² stratified samples per triangle (1..15)
+  double radius_scale = 1.0;           // sphere radius in half bounding-box diagonals (>= 1)
+  bool denoise = true;                 // §3.2.1 row denoising
+  std::size_t grain = 64;              // triangles per parallel task
+  // Called on the calling thread between waves of tasks with (triangles done, total).
+  std::function<void(std::size_t, std::size_t)> progress = {};
+
+  // The viewpoints and samples this configuration uses for mesh m.
+  template <class M>
+  visibility_setup setup(const M& m) const {
+    const bounding_box box = mesh_bounds(m);
+    const double radius = 0.5 * box.diagonal();
+    return {fibonacci_sphere(viewpoints, box.center(), radius_scale * radius), stratified_triangle_samples(samples_per_side),
+            1e-5 * radius};
+  }
+
+  // Traces the occlusion rays. Errors: viewpoints == 0, samples_per_side outside 1..15,
+  // radius_scale < 1 or NaN. Complexity O(T·N·n²) rays, allocation T·N bytes + one ray buffer
+  // per task. Thread-safety: the tracer is called concurrently from the executor's threads.
+  template <class M, class T, class E>
+  result<prepared_visibility_channel> prepare(const M& m, const mesh_topology& topo, const T& tr, E& exec) const {
+    static_assert(check_mesh<M>());
+    static_assert(check_tracer<T>());
+    static_assert(check_executor<std::remove_cvref_t<E>>());
+    if (viewpoints == 0) return make_error(errc::bad_parameter, no_element, "visibility channel: zero viewpoints");
+    if (samples_per_side == 0 || samples_per_side > 15)
+      return make_error(errc::bad_parameter, no_element, "visibility channel: samples_per_side ", samples_per_side,
+                        " outside 1..15");
+    if (!(radius_scale >= 1.0) || !std::isfinite(radius_scale))
+      return make_error(errc::bad_parameter, no_element, "visibility channel: radius_scale ", radius_scale, " must be >= 1");
+    const std::size_t nt = mesh_triangle_count(m), nv = viewpoints;
+    const visibility_setup su = setup(m);
+    prepared_visibility_channel p;
+    p.threshold = threshold;
+    p.denoise = denoise;
+    p.viewpoints = nv;
+    p.samples = static_cast<std::uint32_t>(su.samples.size());
+    p.visible.assign(nt * nv, 0);
+    p.neighbour_offsets = topo.neighbour_offsets;
+    p.neighbours = topo.neighbours;
+    const std::size_t g = std::max<std::size_t>(grain, 1);
+    const std::size_t chunks = chunk_count(nt, g), per_wave = 64;
+    for (std::size_t w0 = 0; w0 < chunks; w0 += per_wave) {
+      const std::size_t w1 = std::min(chunks, w0 + per_wave);
+      exec.parallel_for(w1 - w0, 1, [&](std::size_t cb, std::size_t ce) {
+        std::vector<ray> rays;
+        std::vector<std::uint32_t> slots;
+        std::vector<std::uint8_t> hit;
+        for (std::size_t c = w0 + cb; c < w0 + ce; ++c) {
+          const std::size_t first = c * g, last = std::min(nt, first + g);
+          rays.clear();
+          slots.clear();
+          make_visibility_rays(m, su, first, last, rays, slots);
+          hit.resize(rays.size());
+          trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
+          std::uint8_t* out = p.visible.data() + first * nv;
+          for (std::size_t r = 0; r < rays.size(); ++r) if (!hit[r]) ++out[slots[r]];
+        }
+      });
+      if (progress) progress(std::min(nt, w1 * g), nt);
+    }
+    return p;
+  }
+};
+
+}  // namespace infolerp

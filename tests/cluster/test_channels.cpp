@@ -1,0 +1,236 @@
+// cluster/channel.hpp, orientation_channel.hpp, stretch_channel.hpp, visibility_channel.hpp
+// against brute-force M×M references and analytic cases.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <vector>
+#include <glm/gtc/matrix_transform.hpp>
+#include "brute_tracer.hpp"
+#include "infolerp/cluster/orientation_channel.hpp"
+#include "infolerp/cluster/stretch_channel.hpp"
+#include "infolerp/cluster/visibility_channel.hpp"
+#include "infolerp/mesh/geometry.hpp"
+#include "support/procedural.hpp"
+
+using namespace infolerp;
+
+namespace {
+std::vector<std::uint32_t> all_triangles(std::size_t n) {
+  std::vector<std::uint32_t> v(n);
+  std::iota(v.begin(), v.end(), 0u);
+  return v;
+}
+
+// Full M×M direct channel from a per-pair kernel: rows p(t'|t), p(t) = 1/M.
+template <class K>
+std::vector<std::vector<double>> full_rows(std::size_t m, K kernel) {
+  std::vector<std::vector<double>> rows(m, std::vector<double>(m));
+  for (std::size_t a = 0; a < m; ++a) {
+    double z = 0.0;
+    for (std::size_t b = 0; b < m; ++b) z += rows[a][b] = kernel(a, b);
+    for (std::size_t b = 0; b < m; ++b) rows[a][b] = z > 0.0 ? rows[a][b] / z : 1.0 / double(m);
+  }
+  return rows;
+}
+double full_mi(const std::vector<std::vector<double>>& rows, std::size_t a) {
+  const std::size_t m = rows.size();
+  double sum = 0.0;
+  for (std::size_t y = 0; y < m; ++y) {
+    double py = 0.0;
+    for (std::size_t x = 0; x < m; ++x) py += rows[x][y] / double(m);
+    if (rows[a][y] > 0.0) sum += rows[a][y] * std::log2(rows[a][y] / py);
+  }
+  return sum;
+}
+
+template <class State>
+void compare_with_full(const State& s, const std::vector<std::vector<double>>& rows, double tol) {
+  const std::size_t m = rows.size();
+  for (std::uint32_t a = 0; a < m; a += 7)
+    for (std::uint32_t b = 0; b < m; b += 3) {
+      const double ref = js_divergence(std::span<const double>(rows[a]), std::span<const double>(rows[b]), 0.5);
+      REQUIRE(s.divergence(s.class_of(a), s.class_of(b)) == Approx(ref).margin(tol));
+    }
+  for (std::uint32_t a = 0; a < m; a += 11) REQUIRE(s.mutual_information(s.class_of(a)) == Approx(full_mi(rows, a)).margin(tol));
+}
+}  // namespace
+
+TEST_CASE("orientation exact rows equal the brute-force M x M channel", "[cluster][orientation]") {
+  const auto m = support::make_torus(12, 8, 1.0f, 0.3f);
+  const auto n = face_normals(m);
+  const auto rows = full_rows(n.size(), [&](std::size_t a, std::size_t b) {
+    return std::max(0.0, 1.0 - glm::dot(glm::dvec3(n[a]), glm::dvec3(n[b])));
+  });
+  const auto s = make_orientation_state(n, 0);
+  compare_with_full(s, rows, 1e-9);
+  // A batch column equals single evaluations.
+  std::vector<float> col(s.class_count());
+  s.divergences(3, 0, col);
+  for (std::uint32_t c = 0; c < col.size(); ++c) REQUIRE(col[c] == static_cast<float>(s.divergence(3, c)));
+}
+
+TEST_CASE("orientation: identical normals share one class; a planar patch is all alike", "[cluster][orientation]") {
+  const auto box = support::make_box({0, 0, 0}, {1, 2, 3});
+  const auto s = make_orientation_state(face_normals(box), 0);
+  REQUIRE(s.class_count() == 6);
+  const auto plane = support::make_plane(8, 8, 2.0f);
+  for (std::uint32_t bins : {0u, 256u}) {
+    const auto p = make_orientation_state(face_normals(plane), bins);
+    REQUIRE(p.class_count() == 1);
+    REQUIRE(p.all_alike());
+    REQUIRE(p.divergence(0, 0) == 0.0);
+  }
+}
+
+TEST_CASE("orientation binned rows approach exact rows as K grows", "[cluster][orientation]") {
+  const auto m = support::make_icosphere(3);
+  const auto n = face_normals(m);
+  const auto exact = make_orientation_state(n, 0);
+  double previous = 1.0;
+  for (std::uint32_t bins : {64u, 1024u, 16384u}) {
+    const auto binned = make_orientation_state(n, bins);
+    double worst = 0.0;
+    for (std::uint32_t a = 0; a < n.size(); a += 37)
+      for (std::uint32_t b = 0; b < n.size(); b += 13)
+        worst = std::max(worst, std::abs(binned.divergence(binned.class_of(a), binned.class_of(b)) -
+                                         exact.divergence(exact.class_of(a), exact.class_of(b))));
+    INFO("bins " << bins << " worst |ΔJS| " << worst);
+    REQUIRE(worst < previous);
+    previous = worst;
+  }
+  REQUIRE(previous < 0.02);
+}
+
+TEST_CASE("Degener stretch of analytic Jacobians", "[cluster][stretch]") {
+  const triangle_corners c{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  // J = diag(2, 1): σ1 = 2, σ2 = 1 → (2 + 1/2)·(2 + 1/2) = 6.25.
+  REQUIRE(degener_stretch(c, {0, 0}, {2, 0}, {0, 1}, 1.0, 1.0) == Approx(6.25));
+  // Isometry (a rotation in UV): the minimum, 4.
+  const double r = std::sqrt(0.5);
+  REQUIRE(degener_stretch(c, {0, 0}, {r, r}, {-r, r}, 1.0, 1.0) == Approx(4.0));
+  // θ = 0 keeps only the angle term.
+  REQUIRE(degener_stretch(c, {0, 0}, {2, 0}, {0, 1}, 1.0, 0.0) == Approx(2.5));
+  // Zero-area UV image: the stated special case.
+  REQUIRE(std::isinf(degener_stretch(c, {0, 0}, {1, 0}, {2, 0}, 1.0, 1.0)));
+  const double raw[] = {5.0, 7.0, std::numeric_limits<double>::infinity(), 6.0};
+  const auto s = make_stretch_state(raw, 0);
+  REQUIRE(s.class_count() == 3);  // 7 and the special case both normalise to 1
+  REQUIRE(s.kernel().reps[s.class_of(0)] == 0.0);
+  REQUIRE(s.kernel().reps[s.class_of(1)] == 1.0);
+  REQUIRE(s.kernel().reps[s.class_of(2)] == 1.0);  // special case: the set's largest, 1
+  REQUIRE(s.kernel().reps[s.class_of(3)] == Approx(0.5));
+}
+
+TEST_CASE("stretch exact rows equal the brute-force M x M channel", "[cluster][stretch]") {
+  const auto m = support::make_uv_sphere(10, 8);
+  auto raw = texture_stretch(m);
+  REQUIRE(raw.ok());
+  const auto s = make_stretch_state(*raw, 0);
+  double lo = 1e300, hi = -1e300;
+  for (double v : *raw) lo = std::min(lo, v), hi = std::max(hi, v);
+  std::vector<double> norm(raw->size());
+  for (std::size_t i = 0; i < norm.size(); ++i) norm[i] = ((*raw)[i] - lo) / (hi - lo);
+  const auto rows = full_rows(norm.size(), [&](std::size_t a, std::size_t b) { return 1.0 - std::abs(norm[a] - norm[b]); });
+  compare_with_full(s, rows, 1e-9);
+  // Stretch grows toward the poles: the polar cap is the most stretched, the equator the least.
+  const double equator = (*raw)[2 * 10 * 3 + 1], pole = (*raw)[0];
+  REQUIRE(pole > equator);
+}
+
+TEST_CASE("stretch channel is skipped on meshes without texcoords", "[cluster][stretch]") {
+  const auto m = support::make_icosphere(1);
+  serial_executor exec;
+  auto topo = build_topology(m);
+  REQUIRE(topo.ok());
+  auto p = stretch_channel{}.prepare(m, *topo, 0, exec);
+  REQUIRE(p.ok());
+  REQUIRE(p->skip_reason() != nullptr);
+  REQUIRE_FALSE(p->init(std::vector<std::uint32_t>{0, 1}).ok());
+  auto bad = stretch_channel{.theta = -1.0}.prepare(support::make_uv_sphere(6, 4), *topo, 0, exec);
+  REQUIRE_FALSE(bad.ok());
+  REQUIRE(bad.error().code() == errc::bad_parameter);
+}
+
+TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[cluster][visibility]") {
+  // A floor plane with a small roof above its centre, and a triangle sealed inside a closed box.
+  indexed_mesh scene = support::make_plane(6, 6, 2.0f);
+  const std::size_t floor_count = scene.triangles.size();
+  support::append(scene, support::make_plane(1, 1, 0.6f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 0.3f)));
+  const std::size_t inner = scene.triangles.size();
+  support::append(scene, support::make_plane(1, 1, 0.1f), glm::translate(glm::mat4(1.0f), glm::vec3(3, 3, 0)));
+  support::append(scene, support::make_box({2.8f, 2.8f, -0.2f}, {3.2f, 3.2f, 0.2f}));
+  test::brute_tracer tracer(scene);
+  auto topo = build_topology(scene);
+  REQUIRE(topo.ok());
+  serial_executor exec;
+  std::size_t calls = 0, last = 0;
+  const visibility_channel opts{.viewpoints = 24, .denoise = false,
+                                .progress = [&](std::size_t done, std::size_t total) {
+                                  ++calls;
+                                  REQUIRE(done >= last);
+                                  REQUIRE(total == scene.triangles.size());
+                                  last = done;
+                                }};
+  auto p = opts.prepare(scene, *topo, tracer, exec);
+  REQUIRE(p.ok());
+  REQUIRE(calls >= 1);
+  REQUIRE(last == scene.triangles.size());
+  // The roof's underside is back-facing from above and the floor below the roof is covered.
+  const auto tris = all_triangles(scene.triangles.size());
+  auto s = p->init(tris);
+  REQUIRE(s.ok());
+  // Rows are distributions, p(t) sums to 1 over the set.
+  double total = 0.0;
+  for (std::uint32_t t = 0; t < tris.size(); ++t) {
+    total += s->input_probability(t);
+    if (s->unseen(t)) continue;
+    double row = 0.0;
+    for (float x : s->row(t)) row += x;
+    REQUIRE(row == Approx(1.0).epsilon(1e-5));
+  }
+  REQUIRE(total == Approx(1.0));
+  // The sealed triangles are unseen: their own class.
+  REQUIRE(s->unseen(static_cast<std::uint32_t>(inner)));
+  REQUIRE(s->unseen(static_cast<std::uint32_t>(inner + 1)));
+  REQUIRE(s->divergence(static_cast<std::uint32_t>(inner), static_cast<std::uint32_t>(inner + 1)) == 0.0);
+  REQUIRE(s->divergence(static_cast<std::uint32_t>(inner), 0) == 1.0);
+  REQUIRE(std::isinf(s->mutual_information(static_cast<std::uint32_t>(inner))));
+  // A floor triangle under the roof sees fewer viewpoints than one at the floor's edge.
+  std::size_t under = 0, edge = 0;
+  for (std::size_t t = 0; t < floor_count; ++t) {
+    const auto c = triangle_centroid(corners(scene, t));
+    if (std::abs(c.x) < 0.15 && std::abs(c.y) < 0.15) under = t;
+    if (c.x > 0.8 && c.y > 0.8) edge = t;
+  }
+  std::size_t seen_under = 0, seen_edge = 0;
+  for (std::size_t v = 0; v < p->viewpoints; ++v) {
+    seen_under += p->occlusion_ratio(under, v) > 0.0;
+    seen_edge += p->occlusion_ratio(edge, v) > 0.0;
+  }
+  REQUIRE(seen_under < seen_edge);
+  // Deterministic for any executor.
+  auto p2 = opts.prepare(scene, *topo, tracer, exec);
+  REQUIRE(p2->visible == p->visible);
+}
+
+TEST_CASE("stretch binned rows approach exact rows as K grows", "[cluster][stretch]") {
+  const auto m = support::make_uv_sphere(24, 16);
+  const auto raw = texture_stretch(m);
+  REQUIRE(raw.ok());
+  const auto exact = make_stretch_state(*raw, 0);
+  double previous = 1.0;
+  for (std::uint32_t bins : {64u, 1024u, 16384u, 1u << 20}) {
+    const auto binned = make_stretch_state(*raw, bins);
+    double worst = 0.0;
+    for (std::uint32_t a = 0; a < raw->size(); a += 3)
+      for (std::uint32_t b = 0; b < raw->size(); b += 5)
+        worst = std::max(worst, std::abs(binned.divergence(binned.class_of(a), binned.class_of(b)) -
+                                         exact.divergence(exact.class_of(a), exact.class_of(b))));
+    INFO("bins " << bins << " worst |ΔJS| " << worst);
+    REQUIRE(worst <= previous);
+    previous = worst;
+  }
+  REQUIRE(previous < 1e-4);
+}
