@@ -367,10 +367,13 @@ INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_ta
           const double *xs = &g.x[j], *ys = &g.y[j], *zs = &g.z[j], *cs = &g.value[j];
           double px[block_lanes], py[block_lanes], pz[block_lanes], pc[block_lanes];
           if (j + block_lanes > j1) {  // tail: pad with points outside every ball
+            // At z = +Inf a pad's d² is +Inf at any scale (an absolute offset such as
+            // zi + 4·half + 1 falls inside the ball when 2σ_max > 1 mesh unit, or is absorbed
+            // by a large zi); its weight is masked off bitwise like any point outside.
             for (std::size_t l = 0; l < block_lanes; ++l) {
               const bool in = j + l < j1;
               px[l] = in ? g.x[j + l] : xi, py[l] = in ? g.y[j + l] : yi;
-              pz[l] = in ? g.z[j + l] : zi + 4.0 * half + 1.0, pc[l] = in ? g.value[j + l] : 0.0;
+              pz[l] = in ? g.z[j + l] : std::numeric_limits<double>::infinity(), pc[l] = in ? g.value[j + l] : 0.0;
             }
             xs = px, ys = py, zs = pz, cs = pc;
           }
