@@ -44,7 +44,8 @@ void check_conforming(const infolerp::subdivision_mesh& s) {
   auto topo = infolerp::build_topology(lm);
   FUZZ_CHECK(topo.ok());
   for (std::size_t e = 0; e < topo->edge_count(); ++e) FUZZ_CHECK(topo->edge_valence(e) <= 2);
-  for (const auto& p : s.positions()) FUZZ_CHECK(fuzz::finite(p));
+  for (const auto& t : lm.triangles)  // unused input vertices may hold anything
+    for (int k = 0; k < 3; ++k) FUZZ_CHECK(fuzz::finite(lm.positions[t[k]]));
 }
 }  // namespace
 

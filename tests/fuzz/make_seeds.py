@@ -79,3 +79,10 @@ write("fuzz_upsampler", "basic", up + bytes([0, 3, 2, 1]) + struct.pack("<HH", 3
       bytes([20, 40, 4, 2, 127, 3, 100]) + bytes([30, 60, 90, 120, 60, 30, 10]))
 write("fuzz_upsampler", "one_pixel", struct.pack("<HH", 1, 1) + bytes([16, 16, 1, 1, 1, 1, 7]))
 write("fuzz_upsampler", "plain", struct.pack("<HH", 17, 9) + bytes([1, 1, 8, 0, 3, 2, 254]) + struct.pack("<I", 0xfffffffe) + bytes([5]))
+
+# fuzz_cluster: [flags][th vis][th ori][th str][viewpoints][samples][ori bins][str bins][min fraction][mesh][uvs]
+UV = b"".join(c(u) + c(v) for u, v in [(0, 0), (1, 0), (0, 1)] * 20)
+write("fuzz_cluster", "icosahedron_uv", bytes([5, 76, 10, 25, 6, 1, 16, 8, 2]) + mesh(ICO_V, ICO_T) + UV)
+write("fuzz_cluster", "octahedron_exact_rows", bytes([2, 127, 5, 25, 4, 2, 0, 0, 0]) + mesh(OCTA_V, OCTA_T))
+write("fuzz_cluster", "two_pieces", bytes([4, 40, 60, 25, 3, 1, 9, 0, 10]) +
+      mesh(OCTA_V + [(3, 3, 3), (4, 3, 3), (3, 4, 3)], OCTA_T + [(6, 7, 8)]))

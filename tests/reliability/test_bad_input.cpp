@@ -10,7 +10,7 @@
 // Not covered here: unchecked kernels whose preconditions are documented next to them
 // (js_divergence, js_channel, entropy/mutual_information kernels, corners, face_normals,
 // face_areas, mesh_bounds, connected_components); nld() is total (defined for NaN inputs) and
-// is checked below. Clustering (cluster/) has not landed, so "zero viewpoints" is not covered.
+// is checked below.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -23,6 +23,7 @@
 #include <map>
 #include <string>
 #include <vector>
+#include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 #include "infolerp/mesh/adaptors.hpp"
@@ -104,11 +105,12 @@ std::uint32_t add_vertex(indexed_mesh& m, glm::vec3 p) {
 // Mesh entry points, in the order of mesh_class::want.
 enum mesh_entry : std::size_t {
   e_validate, e_topology, e_curvature, e_saliency_exact, e_saliency_approx, e_salient_clustering,
-  e_cluster_attributes, e_cluster_localized, e_subdivision_build, mesh_entry_count
+  e_cluster_attributes, e_cluster_localized, e_subdivision_build, e_cluster_mesh, mesh_entry_count
 };
 const char* const mesh_entry_names[mesh_entry_count] = {
     "validate_mesh", "build_topology", "mean_curvature", "compute_saliency(exact)", "compute_saliency(approx)",
-    "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::build"};
+    "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::build",
+    "cluster_mesh(visibility+orientation+stretch)"};
 
 struct mesh_class {
   const char* name;
@@ -118,22 +120,23 @@ struct mesh_class {
 
 // Expectations shorthand: the same for every entry point that reads positions (curvature,
 // saliency, clustering, attributes, localised saliency), with validate, topology and the
-// subdivision build given separately.
+// subdivision build given separately. cluster_mesh accepts degenerate and non-manifold input
+// (its rows are defined there), so it expects what reads_positions expects.
 mesh_class make_class(const char* name, indexed_mesh m, expect validate, expect topology, expect reads_positions,
                       expect saliency, expect build) {
   return {name, std::move(m),
           {validate, topology, reads_positions, saliency, saliency, reads_positions, reads_positions, reads_positions,
-           build}};
+           build, reads_positions}};
 }
 
 std::vector<mesh_class> mesh_classes() {
   std::vector<mesh_class> out;
-  const expect empty{errc::empty_input, "no triangles"};
-  out.push_back(make_class("empty mesh", indexed_mesh{}, {errc::empty_input, "empty mesh"}, ok, empty, empty, empty));
+  const expect empty{errc::empty_input, "no triangles"}, empty_mesh{errc::empty_input, "empty mesh"};
+  out.push_back(make_class("empty mesh", indexed_mesh{}, empty_mesh, ok, empty, empty, empty_mesh));
   {
     indexed_mesh m = base();
     m.triangles.clear();
-    out.push_back(make_class("vertices, no triangles", m, {errc::empty_input, "empty mesh"}, ok, empty, empty, empty));
+    out.push_back(make_class("vertices, no triangles", m, empty_mesh, ok, empty, empty, empty_mesh));
   }
   {
     indexed_mesh m = base();
@@ -191,7 +194,7 @@ std::vector<mesh_class> mesh_classes() {
   {
     indexed_mesh m = base();
     add_vertex(m, {nan_f, 0, 0});
-    out.push_back(make_class("isolated NaN vertex", m, ok, ok, ok, ok, {errc::non_finite, "vertex 42"}));
+    out.push_back(make_class("isolated NaN vertex", m, ok, ok, ok, ok, ok));
   }
   {
     indexed_mesh m = base();
@@ -275,6 +278,19 @@ std::pair<status, bool> run_mesh_entry(mesh_entry e, const indexed_mesh& m) {
     case e_cluster_localized: {
       auto r = infolerp::cluster_localized_saliency(m, saliency, one_cluster, 1);
       return {status_of(r), !r.ok() || (r->size() == 3 * nt && all_finite(*r))};
+    }
+    case e_cluster_mesh: {
+      const infolerp::support::brute_force_tracer tracer{&m};  // only called once the mesh is validated
+      auto r = infolerp::cluster_mesh(m, tracer, infolerp::serial_executor{},
+                                      infolerp::visibility_channel{.threshold = 0.3, .viewpoints = 6, .samples_per_side = 1},
+                                      infolerp::orientation_channel{.threshold = 0.05},
+                                      infolerp::stretch_channel{.threshold = 0.1});
+      bool good = true;
+      if (r.ok()) {
+        good = r->cluster_of.size() == nt && r->channels.size() == 3 && r->channels[2].skipped != nullptr;
+        for (auto c : r->cluster_of) good = good && c < r->cluster_count;
+      }
+      return {status_of(r), good};
     }
     case e_subdivision_build: {
       auto r = infolerp::subdivision_mesh::build(m);
@@ -478,6 +494,56 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   check_cell("NaN per-vertex value", "distribute_contractions", dist(prio_nan, cap, 0.5),
              {errc::bad_parameter, "cluster 1: priority"});
   check_cell("mismatched sizes", "distribute_contractions", dist(prio, cap1, 0.5), {errc::bad_size, "capacity 1"});
+}
+
+TEST_CASE("bad-input matrix: clustering options and channels", "[reliability][bad_input]") {
+  const indexed_mesh m = base();
+  const infolerp::support::brute_force_tracer tracer{&m};
+  const infolerp::serial_executor serial;
+  auto vis = [&](infolerp::visibility_channel c) { return status_of(infolerp::cluster_mesh(m, tracer, serial, c)); };
+  auto ori = [&](infolerp::orientation_channel c) { return status_of(infolerp::cluster_mesh(m, tracer, serial, c)); };
+  check_cell("zero viewpoints", "cluster_mesh(visibility)", vis({.viewpoints = 0}), {errc::bad_parameter, "zero viewpoints"});
+  check_cell("zero count", "cluster_mesh(visibility)", vis({.viewpoints = 4, .samples_per_side = 0}),
+             {errc::bad_parameter, "samples_per_side 0"});
+  check_cell("count above size", "cluster_mesh(visibility)", vis({.viewpoints = 4, .samples_per_side = 16}),
+             {errc::bad_parameter, "samples_per_side 16"});
+  check_cell("threshold below 1", "cluster_mesh(visibility)", vis({.viewpoints = 4, .radius_scale = 0.5}),
+             {errc::bad_parameter, "radius_scale"});
+  check_cell("threshold NaN", "cluster_mesh(visibility)", vis({.viewpoints = 4, .radius_scale = nan_d}),
+             {errc::bad_parameter, "radius_scale"});
+  check_cell("threshold below 0", "cluster_mesh(orientation)", ori({.threshold = -0.1}), {errc::bad_parameter, "channel 0: threshold"});
+  check_cell("threshold above 1", "cluster_mesh(orientation)", ori({.threshold = 1.5}), {errc::bad_parameter, "channel 0: threshold"});
+  check_cell("threshold NaN", "cluster_mesh(orientation)", ori({.threshold = nan_d}), {errc::bad_parameter, "channel 0: threshold"});
+  check_cell("threshold NaN", "cluster_mesh(options)",
+             status_of(infolerp::cluster_mesh(m, tracer, serial, infolerp::cluster_options{.min_cluster_fraction = nan_d},
+                                              infolerp::orientation_channel{})),
+             {errc::bad_parameter, "min_cluster_fraction"});
+  check_cell("threshold exactly 0 and 1 (valid)", "cluster_mesh(orientation)", ori({.threshold = 0.0}), ok);
+  check_cell("threshold exactly 0 and 1 (valid)", "cluster_mesh(orientation)", ori({.threshold = 1.0}), ok);
+  {
+    indexed_mesh uv = infolerp::support::make_plane(2, 2, 1.0f);
+    const infolerp::support::brute_force_tracer uv_tracer{&uv};
+    auto str = [&](infolerp::stretch_channel c) { return status_of(infolerp::cluster_mesh(uv, uv_tracer, serial, c)); };
+    check_cell("threshold below 0", "cluster_mesh(stretch)", str({.theta = -1.0}), {errc::bad_parameter, "theta"});
+    uv.texcoords[4].y = nan_f;
+    check_cell("NaN texcoord", "cluster_mesh(stretch)", str({}), {errc::non_finite, "triangle 1 corner 1"});
+  }
+  {
+    indexed_mesh no_frames = base();  // a keyframed type with zero keyframes
+    check_cell("zero keyframes", "cluster_keyframes",
+               status_of(infolerp::cluster_keyframes(
+                   no_frames, [&](std::size_t) -> const infolerp::support::brute_force_tracer& { return tracer; }, serial,
+                   infolerp::cluster_options{}, infolerp::orientation_channel{})),
+               {errc::empty_input, "no keyframes"});
+    indexed_mesh frames = base();
+    frames.keyframes = {frames.positions, frames.positions};
+    frames.keyframes[1][3].x = inf_f;
+    check_cell("Inf position", "cluster_keyframes",
+               status_of(infolerp::cluster_keyframes(
+                   frames, [&](std::size_t) -> const infolerp::support::brute_force_tracer& { return tracer; }, serial,
+                   infolerp::cluster_options{}, infolerp::orientation_channel{})),
+               {errc::non_finite, "vertex 3"});
+  }
 }
 
 TEST_CASE("bad-input matrix: refinement (subdivision, criteria, driver, tracers)", "[reliability][bad_input]") {

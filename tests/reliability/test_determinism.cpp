@@ -1,4 +1,4 @@
-// Determinism (issue 8): every landed component gives bit-identical output across repeated runs
+// Determinism (issue 8): every component gives bit-identical output across repeated runs
 // and for the serial executor and thread_pool_executor with 1, 2 and 8 workers (small grains,
 // so that the work really is split). Components without an executor parameter (topology,
 // salient clustering, subdivision, Jensen–Shannon) are checked across repeated runs and with
@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <cstring>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
+#include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/topology.hpp"
@@ -78,6 +80,27 @@ TEST_CASE("determinism: topology and curvature across repeated runs", "[reliabil
   CHECK(same_bits(a->edge_faces, b->edge_faces));
   CHECK(same_bits(a->neighbours, b->neighbours));
   CHECK(same_bits(*infolerp::mean_curvature(m), *infolerp::mean_curvature(m)));
+}
+
+TEST_CASE("determinism: clustering (Algorithm 1, three channels) for 1, 2, 8 workers", "[reliability][determinism][threads]") {
+  indexed_mesh m = infolerp::support::make_uv_sphere(16, 10);  // textured: the stretch channel runs
+  infolerp::support::append(m, infolerp::support::make_plane(4, 4, 1.5f),
+                            glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -1.3f)));
+  const infolerp::support::brute_force_tracer tracer{&m};
+  const auto outs = with_every_executor([&](auto exec) {
+    auto r = infolerp::cluster_mesh(m, tracer, exec, infolerp::cluster_options{.grain = 2},
+                                    infolerp::visibility_channel{.threshold = 0.2, .viewpoints = 12, .samples_per_side = 1,
+                                                                 .grain = 4},
+                                    infolerp::orientation_channel{.threshold = 0.02, .bins = 64},
+                                    infolerp::stretch_channel{.threshold = 0.05, .bins = 0});
+    REQUIRE(r.ok());
+    return *r;
+  });
+  CHECK(outs[0].cluster_count > 2);
+  for (const auto& o : outs) {
+    CHECK(same_bits(o.cluster_of, outs[0].cluster_of));
+    CHECK(o.cluster_count == outs[0].cluster_count);
+  }
 }
 
 TEST_CASE("determinism: saliency (exact and approximate) for 1, 2, 8 workers", "[reliability][determinism][threads]") {

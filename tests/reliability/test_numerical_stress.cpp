@@ -102,6 +102,7 @@ TEST_CASE("stress: coordinates scaled by 1e30 and 1e-30", "[reliability][stress]
     for (auto method : {infolerp::saliency_method::exact, infolerp::saliency_method::approximate}) {
       auto o = opt;
       o.method = method;
+      INFO("method " << (method == infolerp::saliency_method::exact ? "exact" : "approximate"));
       const auto ss = *infolerp::compute_saliency(ms, o);
       const infolerp::mesh_saliency ref = method == infolerp::saliency_method::exact ? sal : *infolerp::compute_saliency(m, o);
       REQUIRE(all_finite(ss.saliency));
