@@ -112,8 +112,9 @@ TEST_CASE("stress: coordinates scaled by 1e30 and 1e-30", "[reliability][stress]
         for (double& x : scaled) x *= sd;
         CHECK(relative_l2(scaled, ref.levels[i]) < 1e-3);
       }
-      // The final map of the exact method too (the approximate one: see the [!mayfail] test).
-      if (method == infolerp::saliency_method::exact) CHECK(relative_l2(ss.saliency, ref.saliency) < 1e-3);
+      // The final map too (Lee's normalisation is discontinuous at ties, but this mesh has none
+      // at rounding level: measured ~1e-6).
+      CHECK(relative_l2(ss.saliency, ref.saliency) < 1e-3);
 
       // Clustering and per-cluster attributes on the scaled mesh stay finite.
       auto c = infolerp::salient_clustering(ms, ss.saliency, {.clusters = 6});
@@ -139,25 +140,6 @@ TEST_CASE("stress: coordinates scaled by 1e30 and 1e-30", "[reliability][stress]
     const auto loc = sub->locate(0, {0.3f, 0.3f});
     CHECK(sub->is_leaf(loc.leaf));
     CHECK(std::isfinite(loc.weights.x + loc.weights.y + loc.weights.z));
-  }
-}
-
-// Known gap (reported in issue 8): the APPROXIMATE saliency map is not scale-invariant to
-// 1e-3, although its levels are (checked above) and the exact map is. Its representative cells
-// are anchored at the bounding box, so rounding at another scale moves a few vertices to a
-// neighbouring cell; Lee's normalisation counts strict local maxima and amplifies that.
-// Measured: 1.3% relative L2 at scale 1e-30 on this 162-vertex mesh (the approximate mode
-// documents 0.5-6.2% against exact). Kept visible in the test output, not failing CI.
-TEST_CASE("stress: approximate saliency map is scale-invariant to 1e-3", "[reliability][stress][!mayfail]") {
-  const indexed_mesh m = bumpy_sphere(2);
-  const infolerp::saliency_options opt{.epsilon = 0.02, .method = infolerp::saliency_method::approximate};
-  const auto ref = *infolerp::compute_saliency(m, opt);
-  for (const float s : {1e30f, 1e-30f}) {
-    indexed_mesh ms = m;
-    for (auto& p : ms.positions) p *= s;
-    const auto ss = *infolerp::compute_saliency(ms, opt);
-    INFO("scale " << s);
-    CHECK(relative_l2(ss.saliency, ref.saliency) < 1e-3);
   }
 }
 
