@@ -4,7 +4,7 @@
 # The library itself needs only GLM. Run as root (apt-get).
 set -euo pipefail
 
-packages=(cmake make g++ clang libglm-dev catch2 libembree-dev libbenchmark-dev libstb-dev
+packages=(cmake make g++ clang libclang-rt-14-dev libglm-dev catch2 libembree-dev libbenchmark-dev libstb-dev
           libassimp-dev gnuplot-nox)
 missing=()
 for p in "${packages[@]}"; do

@@ -9,6 +9,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/refine/progressive_driver.hpp"
+#include "support/brute_force_tracer.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
 
@@ -16,29 +17,7 @@ using namespace infolerp;  // NOLINT: test file
 
 namespace {
 
-// Möller–Trumbore over every triangle: the reference every fast tracer must agree with.
-struct brute_force_tracer {
-  const indexed_mesh* m;
-  hit intersect(const ray& r) const {
-    hit best;
-    for (std::uint32_t t = 0; t < m->triangles.size(); ++t) {
-      const glm::vec3 a = m->positions[m->triangles[t].x], b = m->positions[m->triangles[t].y],
-                      c = m->positions[m->triangles[t].z];
-      const glm::vec3 e1 = b - a, e2 = c - a, pv = glm::cross(r.direction, e2);
-      const float det = glm::dot(e1, pv);
-      if (std::abs(det) < 1e-12f) continue;
-      const glm::vec3 tv = r.origin - a;
-      const float u = glm::dot(tv, pv) / det;
-      const glm::vec3 qv = glm::cross(tv, e1);
-      const float v = glm::dot(r.direction, qv) / det;
-      const float d = glm::dot(e2, qv) / det;
-      if (u < 0.0f || v < 0.0f || u + v > 1.0f || d < r.tnear || d > r.tfar || d >= best.distance) continue;
-      best = {0, t, {u, v}, d};
-    }
-    return best;
-  }
-  bool occluded(const ray& r) const { return intersect(r).valid(); }
-};
+using support::brute_force_tracer;
 
 // A coarse floor (two triangles) under a camera looking straight down.
 indexed_mesh floor_mesh() { return support::make_plane(1, 1, 2.0f); }

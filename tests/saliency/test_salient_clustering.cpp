@@ -123,7 +123,9 @@ TEST_CASE("cluster-localised saliency (eq. 4) by hand") {
   m.triangles = {{0, 1, 2}, {1, 3, 2}};
   const std::vector<double> sal{1.0, 3.0, 2.0, 7.0};
   const std::vector<std::uint32_t> cluster{0, 1};
-  const auto out = infolerp::cluster_localized_saliency(m, sal, cluster, 2);
+  const auto res = infolerp::cluster_localized_saliency(m, sal, cluster, 2);
+  REQUIRE(res.ok());
+  const std::vector<double>& out = *res;
   // Cluster 0: vertices {0,1,2} values {1,3,2}: min 1, max 3, mean 2.
   CHECK(out[0] == Approx(0.0 + 2.0));
   CHECK(out[1] == Approx(1.0 + 2.0));

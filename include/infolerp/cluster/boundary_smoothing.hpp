@@ -86,7 +86,10 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::vector<double> js_a(u), js_b(u);
   std::vector<std::uint32_t> stamp(u, invalid_id);
   std::uint32_t pair_index = 0;
-  for (const auto& [ca, cb] : pairs) {
+  for (const auto& pair : pairs) {
+    // Plain variables, not a structured binding: the lambda below captures them, which
+    // clang before 16 rejects for structured bindings.
+    const std::uint32_t ca = pair.first, cb = pair.second;
     ++pair_index;
     members.clear();
     std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),

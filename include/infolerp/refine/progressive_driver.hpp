@@ -119,7 +119,8 @@ class progressive_refiner {
 
   // Stage 1 in one call: traces the primary rays, locates every pixel, shades the visible
   // vertices. Camera: any type with width, height and primary_ray(x, y) -> ray.
-  // Errors: an empty image; a hit naming a triangle the mesh does not have (names the pixel).
+  // Errors: an empty image; a hit naming a triangle the mesh does not have, or with a
+  // non-finite distance or barycentric (names the pixel). On error the refiner is unchanged.
   // Complexity O(pixels · (trace + level)); allocation O(pixels + triangles + vertices).
   template <class T, class Camera, class Shade, class E>
   status start(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
@@ -127,25 +128,34 @@ class progressive_refiner {
     static_assert(check_executor<std::remove_cvref_t<E>>());
     static_assert(std::is_invocable_r_v<glm::vec3, Shade&, const shading_point&>,
                   "infolerp: shading callback needs `glm::vec3 shade(const infolerp::shading_point&)`");
-    started_ = std::chrono::steady_clock::now();
-    width_ = camera.width;
-    height_ = camera.height;
-    const std::size_t n = std::size_t(width_) * height_;
-    if (n == 0) return make_error(errc::empty_input, no_element, "camera image is 0x0");
-    pixel_leaf_.assign(n, invalid_id);
-    pixel_weights_.assign(n, glm::vec3(0.0f));
+    const auto started = std::chrono::steady_clock::now();
+    const std::uint32_t width = camera.width, height = camera.height;
+    const std::size_t n = std::size_t(width) * height;
+    if (n == 0) return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
     std::vector<hit> hits(n);
     for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
       std::vector<ray> rays(end - begin);
       for (std::size_t p = begin; p < end; ++p)
-        rays[p - begin] = camera.primary_ray(static_cast<std::uint32_t>(p % width_), static_cast<std::uint32_t>(p / width_));
+        rays[p - begin] = camera.primary_ray(static_cast<std::uint32_t>(p % width), static_cast<std::uint32_t>(p / width));
       trace_intersect(tracer, std::span<const ray>(rays), std::span<hit>(hits.data() + begin, end - begin));
     });
+    for (std::size_t p = 0; p < n; ++p) {  // check every hit before changing any state
+      const hit& h = hits[p];
+      if (!h.valid()) continue;
+      if (h.triangle >= mesh_.original_triangle_count())
+        return make_error(errc::index_out_of_range, p, "pixel ", p, ": hit triangle ", h.triangle,
+                          " is not in the mesh (", mesh_.original_triangle_count(), " triangles)");
+      if (!std::isfinite(h.distance) || !std::isfinite(h.barycentric.x) || !std::isfinite(h.barycentric.y))
+        return make_error(errc::non_finite, p, "pixel ", p, ": hit on triangle ", h.triangle,
+                          " has a non-finite distance or barycentric");
+    }
+    started_ = started;
+    width_ = width;
+    height_ = height;
+    pixel_leaf_.assign(n, invalid_id);
+    pixel_weights_.assign(n, glm::vec3(0.0f));
     for (std::size_t p = 0; p < n; ++p) {
       if (!hits[p].valid()) continue;
-      if (hits[p].triangle >= mesh_.original_triangle_count())
-        return make_error(errc::index_out_of_range, p, "pixel ", p, ": hit triangle ", hits[p].triangle,
-                          " is not in the mesh (", mesh_.original_triangle_count(), " triangles)");
       pixel_leaf_[p] = hits[p].triangle;
       const glm::vec2 b = hits[p].barycentric;
       pixel_weights_[p] = glm::vec3(1.0f - b.x - b.y, b.x, b.y);

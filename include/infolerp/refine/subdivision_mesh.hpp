@@ -59,7 +59,7 @@ struct subdivision_triangle {
   std::uint32_t parent = invalid_id;        // invalid_id for an original triangle
   std::uint32_t first_child = invalid_id;   // children are first_child .. first_child + child_count - 1
   std::uint32_t original = invalid_id;      // the input triangle this one lies in
-  std::uint8_t level = 0;                   // 0 for original triangles
+  std::uint8_t level = 0;                   // 0 for original triangles, parent's + 1 (saturating at 255)
   std::uint8_t child_count = 0;             // 0 (leaf or retired), 2 (1:2 split) or 4 (1:4 split)
   std::uint8_t split_edge = 0;              // for a 1:2 split: the bisected edge k (corner k to k+1)
   std::uint8_t retired = 0;                 // 1 or 2: first or second 1:2 child, replaced by the parent's 1:4 split
@@ -259,11 +259,14 @@ class subdivision_mesh {
     select(t, propagation_depth);
     return {};
   }
-  // Splits each selected triangle in order (see split). Errors: the first id out of range
-  // (the ones before it are split).
+  // Splits each selected triangle in order (see split). Errors: the first id out of range;
+  // then nothing is split (all ids are checked before the mesh changes).
   status split(std::span<const std::uint32_t> selected) {
-    for (std::uint32_t t : selected)
-      if (auto st = split(t); !st) return st;
+    for (std::size_t i = 0; i < selected.size(); ++i)
+      if (selected[i] >= tris_.size())
+        return make_error(errc::index_out_of_range, selected[i], "selection ", i, ": triangle ", selected[i],
+                          " out of range (", tris_.size(), " triangles)");
+    for (std::uint32_t t : selected) select(t, options_.propagation_depth);
     return {};
   }
 
@@ -449,8 +452,9 @@ class subdivision_mesh {
     n.vertices = {a, b, c};
     n.parent = parent;
     n.original = tris_[parent].original;
-    INFOLERP_ASSERT(tris_[parent].level < 255);
-    n.level = static_cast<std::uint8_t>(tris_[parent].level + 1);
+    // Saturates: 255 nested selections are legal input (float positions stopped changing
+    // about 30 levels earlier), so the count stops instead of asserting or wrapping to 0.
+    n.level = static_cast<std::uint8_t>(std::min(tris_[parent].level + 1, 255));
     tris_.push_back(n);
     return id;
   }

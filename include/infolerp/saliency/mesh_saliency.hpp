@@ -367,10 +367,13 @@ INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_ta
           const double *xs = &g.x[j], *ys = &g.y[j], *zs = &g.z[j], *cs = &g.value[j];
           double px[block_lanes], py[block_lanes], pz[block_lanes], pc[block_lanes];
           if (j + block_lanes > j1) {  // tail: pad with points outside every ball
+            // At z = +Inf a pad's d² is +Inf at any scale (an absolute offset such as
+            // zi + 4·half + 1 falls inside the ball when 2σ_max > 1 mesh unit, or is absorbed
+            // by a large zi); its weight is masked off bitwise like any point outside.
             for (std::size_t l = 0; l < block_lanes; ++l) {
               const bool in = j + l < j1;
               px[l] = in ? g.x[j + l] : xi, py[l] = in ? g.y[j + l] : yi;
-              pz[l] = in ? g.z[j + l] : zi + 4.0 * half + 1.0, pc[l] = in ? g.value[j + l] : 0.0;
+              pz[l] = in ? g.z[j + l] : std::numeric_limits<double>::infinity(), pc[l] = in ? g.value[j + l] : 0.0;
             }
             xs = px, ys = py, zs = pz, cs = pc;
           }
@@ -556,8 +559,9 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5 (bad_parameter); a mesh
-// whose bounding box has zero diagonal (degenerate_triangle).
+// scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5, a σ whose square is not a
+// normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a
+// mesh whose bounding box has zero diagonal (degenerate_triangle).
 // Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the pairs
 // within 2σ_max, each counted from both ends); approximate: O(V·σs·k) with
 // k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (16 doubles per
@@ -594,7 +598,15 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   mult.erase(std::unique(mult.begin(), mult.end()), mult.end());
   if (mult.size() > 32) return make_error(errc::bad_parameter, no_element, "at most 16 saliency scales are supported");
   std::vector<double> sigma(mult.size());
-  for (std::size_t u = 0; u < mult.size(); ++u) sigma[u] = mult[u] * out.epsilon;
+  for (std::size_t u = 0; u < mult.size(); ++u) {
+    sigma[u] = mult[u] * out.epsilon;
+    // The Gaussian divides by 2σ²: a σ² that underflows (or overflows) would turn the weights
+    // of coincident vertices into NaN (0 · Inf).
+    const double s2 = sigma[u] * sigma[u];
+    if (!(s2 >= std::numeric_limits<double>::min()) || !std::isfinite(s2))
+      return make_error(errc::bad_parameter, no_element, "saliency sigma ", sigma[u],
+                        " (scale x epsilon x bounding-box diagonal) is outside double precision");
+  }
   auto index_of = [&](double s) {
     return static_cast<std::size_t>(std::lower_bound(mult.begin(), mult.end(), s) - mult.begin());
   };

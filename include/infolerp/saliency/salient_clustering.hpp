@@ -345,14 +345,29 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
 // Cluster-localised saliency (eq. 4), per triangle corner (a vertex on a cluster border has one
 // value per cluster): S_ci = (S_i − min S_c) / (max S_c − min S_c) + μ(S_c), with min, max and
 // mean over the vertices of cluster c's triangles (each vertex once); the first term is 0 when
-// max S_c = min S_c. Preconditions: saliency has one value per vertex, cluster one id <
-// cluster_count per triangle, indices valid. Complexity O(V + T); allocation O(T + V + clusters).
+// max S_c = min S_c.
+// Errors: mesh errors as mean_curvature; saliency.size() != V or cluster.size() != T
+// (bad_size); a non-finite or negative saliency (names the vertex); a cluster id >=
+// cluster_count (names the triangle). Complexity O(V + T); allocation O(T + V + clusters).
 // Serial; pure.
 template <class M>
-std::vector<double> cluster_localized_saliency(const M& m, std::span<const double> saliency,
-                                               std::span<const std::uint32_t> cluster, std::uint32_t cluster_count) {
+result<std::vector<double>> cluster_localized_saliency(const M& m, std::span<const double> saliency,
+                                                       std::span<const std::uint32_t> cluster,
+                                                       std::uint32_t cluster_count) {
   static_assert(check_mesh<M>());
+  if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
   const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
+  if (saliency.size() != nv)
+    return make_error(errc::bad_size, saliency.size(), "saliency has ", saliency.size(), " values for ", nv, " vertices");
+  if (cluster.size() != nt)
+    return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
+  for (std::size_t v = 0; v < nv; ++v)
+    if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
+      return make_error(errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
+  for (std::size_t t = 0; t < nt; ++t)
+    if (cluster[t] >= cluster_count)
+      return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
+                        cluster_count);
   std::vector<double> lo(cluster_count, std::numeric_limits<double>::infinity()),
       hi(cluster_count, -std::numeric_limits<double>::infinity()), sum(cluster_count, 0.0);
   std::vector<double> count(cluster_count, 0.0);

@@ -1,0 +1,88 @@
+#!/usr/bin/env python3
+"""Writes the seed corpus (tests/fuzz/corpus/<target>/*) in the byte formats the targets read
+(see fuzz_common.hpp and the comment at the top of each target). Run from anywhere; the files
+are committed, so this only needs re-running when a format changes."""
+import os
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def c(v):  # a coordinate on the 1/16 grid
+    return bytes([int(round(v * 16)) + 127])
+
+
+def mesh(vertices, triangles, scale=0):
+    out = bytes([len(vertices), len(triangles), scale & 0xFF])
+    for p in vertices:
+        out += b"".join(c(x) for x in p)
+    for t in triangles:
+        out += bytes(t)
+    return out
+
+
+OCTA_V = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+OCTA_T = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+G = 1.625  # golden ratio on the 1/16 grid
+ICO_V = [(-1, G, 0), (1, G, 0), (-1, -G, 0), (1, -G, 0), (0, -1, G), (0, 1, G), (0, -1, -G), (0, 1, -G),
+         (G, 0, -1), (G, 0, 1), (-G, 0, -1), (-G, 0, 1)]
+ICO_T = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6),
+         (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10),
+         (8, 6, 7), (9, 8, 1)]
+
+
+def write(target, name, data):
+    d = os.path.join(HERE, "corpus", target)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+# fuzz_mesh: [flags][mesh]
+write("fuzz_mesh", "octahedron", bytes([0]) + mesh(OCTA_V, OCTA_T))
+write("fuzz_mesh", "icosahedron_stride20", bytes([0x20]) + mesh(ICO_V, ICO_T))
+write("fuzz_mesh", "non_manifold", bytes([0]) + mesh(OCTA_V + [(2, 2, 2)], OCTA_T + [(0, 2, 6)]))
+write("fuzz_mesh", "nan_vertex", bytes([4]) + mesh(OCTA_V, OCTA_T)[:3 + 3] + b"\xff" + struct.pack("<f", float("nan"))
+      + mesh(OCTA_V, OCTA_T)[3 + 3 + 1:])
+write("fuzz_mesh", "degenerate_allowed", bytes([1]) + mesh(OCTA_V, OCTA_T[:-1] + [(0, 0, 5)]))
+write("fuzz_mesh", "huge_scale", bytes([0]) + mesh(OCTA_V, OCTA_T, scale=100))
+
+# fuzz_jensen_shannon: [mode][weight][bins u16][entries]
+write("fuzz_jensen_shannon", "equal_sizes", bytes([1, 127]) + struct.pack("<H", 8) +
+      bytes([64, 80, 0, 200, 100, 65, 0, 9]) + bytes([100, 0, 70, 70, 250, 64, 3, 90]) + bytes([127] * 8))
+write("fuzz_jensen_shannon", "subnormal_huge", bytes([7, 60]) + struct.pack("<H", 4) +
+      bytes([253, 5, 252, 3, 64, 253, 1]) + bytes([70, 252, 9, 253, 7, 80]) + bytes([100] * 20))
+write("fuzz_jensen_shannon", "mismatch", bytes([0, 127]) + struct.pack("<H", 3) + struct.pack("<H", 2) +
+      bytes([64, 65, 66, 67, 68]))
+
+# fuzz_saliency: [flags][epsilon][scale count][scales][cells per sigma][clusters][seed][mesh][pool][iterations]
+# [camera][capacities][target u16][lambda]
+sal_head = bytes([0, 64, 2, 85, 127, 180, 3, 1])
+write("fuzz_saliency", "icosahedron_exact", sal_head + mesh(ICO_V, ICO_T) + bytes([60, 4]) + c(3) + c(0) + c(0) +
+      bytes([10] * 3) + struct.pack("<H", 20) + bytes([10]))
+write("fuzz_saliency", "icosahedron_approx", bytes([1]) + sal_head[1:] + mesh(ICO_V, ICO_T) + bytes([0, 2]) + c(0) +
+      c(4) + c(1) + bytes([3] * 3) + struct.pack("<H", 5) + bytes([127]))
+write("fuzz_saliency", "octahedron_one_scale", bytes([0, 40, 1, 127, 100, 2, 9]) + mesh(OCTA_V, OCTA_T) + bytes([254, 1]))
+
+# fuzz_subdivision: [flags][bisect][depth][mesh unless flags & 1] then operations
+# op code % 5: 0 split id (u16, depth u8), 1 newest (back u8), 2 selection (count u8, u16 ids),
+# 3 locate (original u8, u, v), 4 tessellate (limit, max level); bits 5-7 all set also check conformity.
+ops = bytes([0x82, 3, 0, 1, 0x83, 0, 0x84, 3, 0, 0, 1, 0, 2, 0, 0x80, 1, 50, 80, 0x81, 40, 3, 0x83, 0, 0x83, 0,
+             0x82, 7, 0, 0, 0x02, 2, 1, 0, 0xE8, 0x03])
+write("fuzz_subdivision", "grid_ops", bytes([1 | (2 << 1), 127, 1]) + ops)
+write("fuzz_subdivision", "octahedron_ops", bytes([0, 64, 2]) + mesh(OCTA_V, OCTA_T) + ops)
+write("fuzz_subdivision", "deep_chain", bytes([1, 127, 1]) + bytes([0x83, 3] * 300) + bytes([0x80, 0, 20, 30]))
+
+# fuzz_upsampler: [w u16][h u16][passes][max passes][rows][flags][cell][id count][ids] then ops, controller
+up = struct.pack("<HH", 61, 47) + bytes([4, 4, 2, 3, 6, 4, 0, 1, 255, 2])
+write("fuzz_upsampler", "basic", up + bytes([0, 3, 2, 1]) + struct.pack("<HH", 33, 20) + bytes([2]) +
+      bytes([20, 40, 4, 2, 127, 3, 100]) + bytes([30, 60, 90, 120, 60, 30, 10]))
+write("fuzz_upsampler", "one_pixel", struct.pack("<HH", 1, 1) + bytes([16, 16, 1, 1, 1, 1, 7]))
+write("fuzz_upsampler", "plain", struct.pack("<HH", 17, 9) + bytes([1, 1, 8, 0, 3, 2, 254]) + struct.pack("<I", 0xfffffffe) + bytes([5]))
+
+# fuzz_cluster: [flags][th vis][th ori][th str][viewpoints][samples][ori bins][str bins][min fraction][mesh][uvs]
+UV = b"".join(c(u) + c(v) for u, v in [(0, 0), (1, 0), (0, 1)] * 20)
+write("fuzz_cluster", "icosahedron_uv", bytes([5, 76, 10, 25, 6, 1, 16, 8, 2]) + mesh(ICO_V, ICO_T) + UV)
+write("fuzz_cluster", "octahedron_exact_rows", bytes([2, 127, 5, 25, 4, 2, 0, 0, 0]) + mesh(OCTA_V, OCTA_T))
+write("fuzz_cluster", "two_pieces", bytes([4, 40, 60, 25, 3, 1, 9, 0, 10]) +
+      mesh(OCTA_V + [(3, 3, 3), (4, 3, 3), (3, 4, 3)], OCTA_T + [(6, 7, 8)]))
