@@ -30,6 +30,7 @@
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/saliency/salient_clustering.hpp"
 
 namespace infolerp {
 
@@ -58,19 +59,8 @@ template <class M>
 result<cluster_table> compute_cluster_attributes(const M& m, std::span<const double> saliency,
                                                  std::span<const std::uint32_t> cluster, std::uint32_t cluster_count) {
   static_assert(check_mesh<M>());
-  if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
-  const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
-  if (saliency.size() != nv)
-    return make_error(errc::bad_size, saliency.size(), "saliency has ", saliency.size(), " values for ", nv, " vertices");
-  if (cluster.size() != nt)
-    return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
-  for (std::size_t v = 0; v < nv; ++v)
-    if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
-      return make_error(errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
-  for (std::size_t t = 0; t < nt; ++t)
-    if (cluster[t] >= cluster_count)
-      return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
-                        cluster_count);
+  if (status s = detail::check_cluster_inputs(m, saliency, cluster, cluster_count); !s.ok()) return s;
+  const std::size_t nt = mesh_triangle_count(m);
   cluster_table out;
   auto& cs = out.clusters;
   cs.assign(cluster_count, {});

@@ -342,6 +342,30 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
   return out;
 }
 
+namespace detail {
+// Inputs of the per-cluster functions (eq. 4 here, attributes in cluster_importance.hpp): a
+// valid mesh, one finite non-negative saliency per vertex, one cluster id < cluster_count per
+// triangle. Names the offending vertex or triangle. O(V + T), no allocation.
+template <class M>
+status check_cluster_inputs(const M& m, std::span<const double> saliency, std::span<const std::uint32_t> cluster,
+                            std::uint32_t cluster_count) {
+  if (status s = check_indices_and_positions(m); !s.ok()) return s;
+  const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
+  if (saliency.size() != nv)
+    return make_error(errc::bad_size, saliency.size(), "saliency has ", saliency.size(), " values for ", nv, " vertices");
+  if (cluster.size() != nt)
+    return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
+  for (std::size_t v = 0; v < nv; ++v)
+    if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
+      return make_error(errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
+  for (std::size_t t = 0; t < nt; ++t)
+    if (cluster[t] >= cluster_count)
+      return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
+                        cluster_count);
+  return {};
+}
+}  // namespace detail
+
 // Cluster-localised saliency (eq. 4), per triangle corner (a vertex on a cluster border has one
 // value per cluster): S_ci = (S_i − min S_c) / (max S_c − min S_c) + μ(S_c), with min, max and
 // mean over the vertices of cluster c's triangles (each vertex once); the first term is 0 when
@@ -355,19 +379,8 @@ result<std::vector<double>> cluster_localized_saliency(const M& m, std::span<con
                                                        std::span<const std::uint32_t> cluster,
                                                        std::uint32_t cluster_count) {
   static_assert(check_mesh<M>());
-  if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
+  if (status s = detail::check_cluster_inputs(m, saliency, cluster, cluster_count); !s.ok()) return s;
   const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
-  if (saliency.size() != nv)
-    return make_error(errc::bad_size, saliency.size(), "saliency has ", saliency.size(), " values for ", nv, " vertices");
-  if (cluster.size() != nt)
-    return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
-  for (std::size_t v = 0; v < nv; ++v)
-    if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
-      return make_error(errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
-  for (std::size_t t = 0; t < nt; ++t)
-    if (cluster[t] >= cluster_count)
-      return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
-                        cluster_count);
   std::vector<double> lo(cluster_count, std::numeric_limits<double>::infinity()),
       hi(cluster_count, -std::numeric_limits<double>::infinity()), sum(cluster_count, 0.0);
   std::vector<double> count(cluster_count, 0.0);
