@@ -9,6 +9,9 @@
 //
 // CSV: criterion,stage,shading_samples,triangles,triangles_total,seconds,psnr_db
 // (stage 1: initial geometry shaded; stage 2: refinement stopped by the budget or the rule).
+// seconds is wall time per run; benchmarks/results/refine.csv was made with OMP_NUM_THREADS=1
+// (with two OpenMP threads on the shared 2-core machine it varied 5-20x with the other load;
+// every other column is the same for any thread count).
 // Tracing: Embree 3 (tests/support/embree_tracer.hpp). Shading: Lambert with a hard sun
 // shadow ray and a sky term (support::reference_shader is tied to the demo scene's textured,
 // multi-object layout, so this scene keeps its own shader of the same style).
