@@ -53,6 +53,8 @@ struct upsampler_options {
   std::uint32_t rows_per_task = 4;  // rows of a pass per executor task (the parallel_for grain)
   bool record_kinds = true;         // keep the R/I/E kind of every pixel of the last pass (kinds())
   bool keep_ibuffer = false;        // keep the last pass's samples (ibuffer()); off: shade straight into the frame
+  std::uint32_t min_sources = 2;    // sources with probes only: fewest sources compatible with a new sample's
+                                    // probe that it is interpolated from (1 or 2; else it is evaluated)
 };
 
 // Statistics of one pass.
@@ -110,6 +112,15 @@ template <class S>
   }
   return source_compatible(src, a, b);
 }
+
+// The same between a new sample's probe p and a source sample a.
+template <class S>
+[[nodiscard]] inline bool may_complete(const S& src, const sample_of<S>& p, const sample_of<S>& a) {
+  if constexpr (has_background_flag<sample_of<S>>) {
+    if (static_cast<bool>(p.background()) != static_cast<bool>(a.background())) return false;
+  }
+  return source_probe_compatible(src, p, a);
+}
 }  // namespace detail
 
 // The stateful upsampler (geometry-central style: construct once, render every frame).
@@ -133,6 +144,9 @@ class upsampler {
     if (options.max_passes == 0 || options.max_passes > max_upsample_passes)
       return make_error(errc::bad_parameter, no_element, "upsampler: max_passes ", options.max_passes,
                         " outside [1, ", max_upsample_passes, "]");
+    if (options.min_sources == 0 || options.min_sources > 2)
+      return make_error(errc::bad_parameter, no_element, "upsampler: min_sources ", options.min_sources,
+                        " outside [1, 2]");
     if (options.rows_per_task == 0)
       return make_error(errc::bad_parameter, no_element, "upsampler: rows_per_task must be at least 1");
     if (status s = u.set_passes(options.passes); !s) return s;
@@ -211,7 +225,11 @@ class upsampler {
         });
       } else {
         run_rows(exec, d, [&](std::uint32_t j, std::array<std::size_t, 3>& counts) {
-          upsample_row(src, d, j, out, counts);
+          if constexpr (probing_sample_source<S>) {
+            probe_row(src, d, j, out, counts);
+          } else {
+            upsample_row(src, d, j, out, counts);
+          }
         });
       }
       pass_stats& ps = stats_.pass[k];
@@ -333,6 +351,76 @@ class upsampler {
         } else {
           store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
         }
+      }
+    }
+  }
+
+  // Later passes with probes: R as above; every new sample probes its own pixel and is
+  // interpolated from the sources compatible with its probe. Edge: both sources, or one when
+  // min_sources is 1. Centre, by the compatible corners: all four (weights 1/4); three, the
+  // diagonal opposite the missing corner (the centre is its midpoint, so a plane through the
+  // three corners is reproduced exactly); two, that pair; one, that corner when min_sources is
+  // 1. Otherwise evaluated.
+  template <class S, class Pixel>
+  void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
+                 std::array<std::size_t, 3>& counts) {
+    const std::uint32_t w = extents_[d][0];
+    const std::uint32_t pw = extents_[d + 1][0];
+    const bool single = options_.min_sources <= 1;
+    const Sample* prev = levels_[d + 1].data();
+    const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;
+    const Sample* r1 = (j & 1u) ? r0 + pw : r0;
+    for (std::uint32_t i = 0; i < w; ++i) {
+      const std::uint32_t a = i / 2;
+      if ((j & 1u) == 0 && (i & 1u) == 0) {
+        store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
+        continue;
+      }
+      const std::uint32_t x = i << d, y = j << d;
+      Sample p = src.probe(x, y);
+      const bool centre = (i & 1u) && (j & 1u);
+      if (!centre) {
+        const Sample& s0 = r0[a];
+        const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
+        const bool m0 = detail::may_complete(src, p, s0), m1 = detail::may_complete(src, p, s1);
+        if (m0 && m1 && detail::may_interpolate(src, s0, s1)) {
+          store(src, d, i, j, detail::source_interpolate(src, p, s0, s1), sample_kind::interpolated, out, counts);
+        } else if (single && (m0 || m1)) {
+          const Sample& s = m0 ? s0 : s1;
+          store(src, d, i, j, detail::source_interpolate(src, p, s, s), sample_kind::interpolated, out, counts);
+        } else {
+          store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+        }
+        continue;
+      }
+      const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
+      unsigned mask = 0;
+      for (unsigned k = 0; k < 4; ++k) mask |= detail::may_complete(src, p, *c[k]) ? 1u << k : 0u;
+      if (mask == 0xF && !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
+                           detail::may_interpolate(src, *c[0], *c[3])))
+        mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out): evaluate
+      const Sample* s0 = nullptr;
+      const Sample* s1 = nullptr;
+      switch (mask) {
+        case 0xF:
+          store(src, d, i, j, detail::source_interpolate(src, p, *c[0], *c[1], *c[2], *c[3]), sample_kind::interpolated,
+                out, counts);
+          continue;
+        case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
+        case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
+        case 0x3: s0 = c[0]; s1 = c[1]; break;                      // adjacent pairs
+        case 0xC: s0 = c[2]; s1 = c[3]; break;
+        case 0x5: s0 = c[0]; s1 = c[2]; break;
+        case 0xA: s0 = c[1]; s1 = c[3]; break;
+        case 0x1: case 0x2: case 0x4: case 0x8:
+          if (single) s0 = s1 = c[mask == 0x1 ? 0 : mask == 0x2 ? 1 : mask == 0x4 ? 2 : 3];
+          break;
+        default: break;
+      }
+      if (s0 != nullptr && detail::may_interpolate(src, *s0, *s1)) {
+        store(src, d, i, j, detail::source_interpolate(src, p, *s0, *s1), sample_kind::interpolated, out, counts);
+      } else {
+        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
       }
     }
   }
