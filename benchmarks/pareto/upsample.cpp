@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <atomic>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -33,6 +34,7 @@
 #include <omp.h>
 #include "infolerp/upsample/upsampler.hpp"
 #include "pareto.hpp"
+#include "support/demo_clusters.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
@@ -105,7 +107,7 @@ class harness {
   harness(const sup::demo_scene& scene, const sup::shader_options& shading, int width, int height, int threads)
       : scene_(scene), shading_(shading), single_(scene, shading), w_(width), h_(height), threads_(threads) {}
 
-  int run(const std::string& csv_path) {
+  int run(const std::string& csv_path, const sup::scene_clustering& features) {
     // (1) the reference: full per-pixel evaluation with single rays.
     {
       const double t0 = now_seconds();
@@ -116,7 +118,7 @@ class harness {
       add("full_single", "1 ray per call", t_full_, 1.0, reference_);
     }
     // (2) 16-ray packets.
-    {
+    if (want("full_packets16")) {
       sup::shader_options o = shading_;
       o.packets = true;
       const sup::reference_shader packets(scene_, o);
@@ -130,9 +132,10 @@ class harness {
     std::vector<sup::scene_clustering> clusterings;
     clusterings.push_back(sup::cluster_by_object(scene_));
     for (int cells : {1, 2, 4}) clusterings.push_back(sup::cluster_by_normal(scene_, cells));
+    clusterings.push_back(features);
     std::vector<double> matched_fraction(6, 1.0);  // evaluated fraction of the finest stand-in, per passes
     for (const auto& c : clusterings) {
-      for (std::uint32_t passes = 1; passes <= 5; ++passes) {
+      for (std::uint32_t passes = 1; passes <= 5 && want("ibuffer"); ++passes) {
         const sup::demo_ibuffer_source src{&single_, &c, w_, h_};
         double f = 0;
         if (!run_upsampler<sample>(src, passes, "ibuffer",
@@ -141,8 +144,39 @@ class harness {
         if (c.name == "normal2") matched_fraction[passes] = f;
       }
     }
+    // (6a) the feature clustering with screen-linear weights (the paper's interpolation).
+    for (std::uint32_t passes = 2; passes <= 5 && want("ibuffer_linear"); ++passes) {
+      const sup::demo_ibuffer_source src{&single_, &features, w_, h_, false};
+      double f = 0;
+      if (!run_upsampler<sample>(src, passes, "ibuffer_linear",
+                                 "feature (" + std::to_string(features.count()) + " clusters), screen-linear weights, " + std::to_string(passes) + " passes", f))
+        return 1;
+    }
+    // (6c) the I-Buffer with probes: primary hit + sun at every pixel, AO and soft shadow interpolated.
+    if (want("ibuffer_probe")) {
+      for (bool probe_lights : {false, true}) {
+        sup::shader_options po = shading_;
+        po.ao_rays = 0;
+        po.soft_shadow_rays = 0;
+        po.hard_shadow = probe_lights;
+        const sup::reference_shader primary(scene_, po);
+        for (std::uint32_t min_sources : {1u, 2u})
+          for (std::uint32_t passes = 3; passes <= 6; ++passes) {
+            sup::demo_probe_source src;
+            static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &features, w_, h_};
+            src.primary = &primary;
+            src.probe_lights = probe_lights;
+            double f = 0;
+            char setting[128];
+            std::snprintf(setting, sizeof setting, "feature (%zu), probe primary%s, min %u src, %u passes", features.count(),
+                          probe_lights ? "+sun" : "", min_sources, passes);
+            if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+          }
+      }
+    }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {
+      if (!want("ibuffer_occl")) break;
       for (std::uint32_t passes = 3; passes <= 5; ++passes) {
         occlusion_checked_source src;
         static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusterings[2], w_, h_};
@@ -155,6 +189,7 @@ class harness {
     }
     // (5) the same schedule deciding by luminance contrast.
     for (float threshold : {0.02f, 0.05f}) {
+      if (!want("contrast")) break;
       for (std::uint32_t passes = 2; passes <= 5; ++passes) {
         const contrast_source src{{&single_, &clusterings[0], w_, h_}, threshold};
         double f = 0;
@@ -164,13 +199,156 @@ class harness {
       }
     }
     // (3) uniform low resolution + bilinear at the I-Buffer's evaluated fraction.
-    for (std::uint32_t passes = 2; passes <= 5; ++passes) lowres_bilinear(matched_fraction[passes], passes);
+    for (std::uint32_t passes = 2; passes <= 5 && want("lowres_bilinear"); ++passes) lowres_bilinear(matched_fraction[passes], passes);
     // (4) joint-bilateral upsampling of the expensive terms from a 2^(p-1) grid.
-    for (std::uint32_t passes = 2; passes <= 5; ++passes) joint_bilateral(1 << (passes - 1));
+    for (std::uint32_t passes = 2; passes <= 5 && want("joint_bilateral"); ++passes) joint_bilateral(1 << (passes - 1));
     return write(csv_path);
   }
 
+
+  // --diagnose: where the I-Buffer's error and time go, for the feature clustering at 3 and 4
+  // passes. Error: PSNR of the I-Buffer frame with one group of its record replaced by the
+  // reference's values at every pixel (what is left is the other groups' error), and the
+  // squared-error share of evaluated / interpolated / reused pixels. Time: evaluate() calls
+  // (timed inside the source), shading of the final I-Buffer alone, the rest (R/I decisions,
+  // interpolation, copies, bookkeeping); and the per-pixel cost of a full evaluation, of a
+  // primary ray + sun ray, and of a primary ray alone.
+  int diagnose(const sup::scene_clustering& clusters) {
+    const std::size_t n = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
+    const int nthreads = threads_ > 0 ? threads_ : omp_get_max_threads();
+    std::vector<sup::shading_inputs> ref(n);
+    sup::image refimg(w_, h_);
+    double t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        std::uint64_t rays = 0;
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+        ref[i] = single_.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays);
+        refimg.pixels[i] = single_.shade(ref[i]);
+      }
+    const double t_full = now_seconds() - t0;
+    sup::shader_options po = shading_;
+    po.ao_rays = 0;
+    po.soft_shadow_rays = 0;
+    const sup::reference_shader primary(scene_, po);
+    double sink = 0;
+    t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads) reduction(+ : sink)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        std::uint64_t rays = 0;
+        sink += static_cast<double>(primary.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays).normal.x);
+      }
+    const double t_primary_sun = now_seconds() - t0;
+    t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads) reduction(+ : sink)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x)
+        sink += scene_.tracer.intersect(scene_.view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_)).valid() ? 1.0 : 0.0;
+    const double t_primary = now_seconds() - t0;
+    std::printf("per-pixel cost (%d threads, wall): full %.0f ns, primary+sun %.0f ns (%.3f of full), primary %.0f ns (%.3f of full)  [%g]\n",
+                nthreads, 1e9 * t_full / static_cast<double>(n), 1e9 * t_primary_sun / static_cast<double>(n), t_primary_sun / t_full,
+                1e9 * t_primary / static_cast<double>(n), t_primary / t_full, sink > 0 ? 1.0 : 0.0);
+
+    struct timed_source : sup::demo_ibuffer_source {
+      std::atomic<long long>* eval_ns = nullptr;
+      sample evaluate(std::uint32_t x, std::uint32_t y) const {
+        const auto a = std::chrono::steady_clock::now();
+        sample s = sup::demo_ibuffer_source::evaluate(x, y);
+        *eval_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - a).count();
+        return s;
+      }
+    };
+    for (std::uint32_t passes : {3u, 4u}) {
+      std::atomic<long long> eval_ns{0};
+      timed_source src;
+      static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusters, w_, h_};
+      src.eval_ns = &eval_ns;
+      auto up = infolerp::upsampler<sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
+                                                    {.passes = passes, .max_passes = passes, .rows_per_task = 2, .keep_ibuffer = true});
+      if (!up) return fail(up.error().message());
+      sup::image img(w_, h_);
+      if (auto s = up->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads_}); !s) return fail(s.message());
+      const auto& st = up->stats();
+      const auto buf = up->ibuffer();
+      sup::image shaded(w_, h_);
+      t0 = now_seconds();
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+      for (int y = 0; y < h_; ++y)
+        for (int x = 0; x < w_; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+          shaded.pixels[i] = src.shade(buf[i], static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y));
+        }
+      const double t_shade = now_seconds() - t0;
+      const double t_eval = 1e-9 * static_cast<double>(eval_ns.load()) / nthreads;
+      std::printf("\n%u passes, %s (%zu clusters): frame %.3f s (x%.2f), evaluated %.4f, PSNR %.2f dB\n", passes,
+                  clusters.name.c_str(), clusters.count(), st.seconds, t_full / st.seconds, st.evaluated_fraction(), *sup::psnr(refimg, img));
+      std::printf("  time: evaluate %.3f s (%.0f%%; %.0f ns per evaluation per thread), shade %.3f s (%.0f%%), rest (R/I tests, interpolation) %.3f s (%.0f%%)\n",
+                  t_eval, 100 * t_eval / st.seconds, 1e9 * t_eval * nthreads / static_cast<double>(st.evaluated()), t_shade,
+                  100 * t_shade / st.seconds, st.seconds - t_eval - t_shade, 100 * (st.seconds - t_eval - t_shade) / st.seconds);
+      for (std::uint32_t p = 0; p < st.passes; ++p)
+        std::printf("  pass %u: %ux%u R %zu I %zu E %zu %.3f s\n", p + 1, st.pass[p].width, st.pass[p].height, st.pass[p].reused,
+                    st.pass[p].interpolated, st.pass[p].evaluated, st.pass[p].seconds);
+      // Error groups: replace one group by the reference at every pixel.
+      enum group { geometry, normal, texcoord, lights, occlusion, count };
+      const char* names[] = {"object/position", "normal", "texcoords", "sun bit", "AO+soft"};
+      auto variant = [&](int fixed_mask) {
+        sup::image v(w_, h_);
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+        for (int y = 0; y < h_; ++y)
+          for (int x = 0; x < w_; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+            sup::shading_inputs in = src.to_inputs(buf[i], static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y));
+            const sup::shading_inputs& r = ref[i];
+            if (r.hit() != in.hit() || ((fixed_mask & (1 << geometry)) && r.hit())) {
+              if (r.hit() != in.hit()) in = r;
+              in.geometry = r.geometry;
+              in.position = r.position;
+            }
+            if (r.hit() && in.hit()) {
+              if (fixed_mask & (1 << normal)) in.normal = r.normal;
+              if (fixed_mask & (1 << texcoord)) in.uv = r.uv;
+              if ((fixed_mask & (1 << count)) && glm::length(in.uv - r.uv) > 0.05f) in.uv = r.uv;  // only texcoord jumps (seams)
+              if (fixed_mask & (1 << lights)) in.light_bits = r.light_bits;
+              if (fixed_mask & (1 << occlusion)) {
+                in.ao = r.ao;
+                in.soft_shadow = r.soft_shadow;
+              }
+            }
+            v.pixels[i] = single_.shade(in);
+          }
+        return *sup::psnr(refimg, v);
+      };
+      std::printf("  PSNR with one group exact (the rest as interpolated):");
+      for (int g = 0; g < count; ++g) std::printf(" %s %.2f,", names[g], variant(1 << g));
+      std::printf("\n  PSNR with only one group interpolated (the rest exact):");
+      for (int g = 0; g < count; ++g) std::printf(" %s %.2f,", names[g], variant(((1 << count) - 1) & ~(1 << g)));
+      std::printf("\n  PSNR with texcoords exact where they are off by > 0.05 (seams), the rest as interpolated: %.2f", variant(1 << count));
+      std::printf("\n  PSNR with exact primary hit + sun (object, position, normal, texcoords, sun bit), AO+soft as interpolated: %.2f\n",
+                  variant(((1 << count) - 1) & ~(1 << occlusion)));
+      // Squared error by kind.
+      std::array<double, 3> se{}, cnt{};
+      const auto kinds = up->kinds();
+      for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 d = glm::clamp(img.pixels[i], 0.0f, 1.0f) - glm::clamp(refimg.pixels[i], 0.0f, 1.0f);
+        se[static_cast<std::size_t>(kinds[i])] += static_cast<double>(glm::dot(d, d));
+        cnt[static_cast<std::size_t>(kinds[i])] += 1;
+      }
+      const double tot = se[0] + se[1] + se[2];
+      std::printf("  squared-error share (linear, clamped): E %.1f%% of %g px, I %.1f%% of %g px, R %.1f%% of %g px\n", 100 * se[0] / tot,
+                  cnt[0], 100 * se[1] / tot, cnt[1], 100 * se[2] / tot, cnt[2]);
+    }
+    return 0;
+  }
+
  private:
+  // --only METHOD[,METHOD...]: run only these methods (and the reference).
+  bool want(const std::string& method) const {
+    if (only_.empty()) return true;
+    return ("," + only_ + ",").find("," + method + ",") != std::string::npos;
+  }
+
   static int fail(const std::string& message) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", message.c_str());
     return 1;
@@ -189,9 +367,10 @@ class harness {
 
   template <class Sample, class Source>
   bool run_upsampler(const Source& src, std::uint32_t passes, const std::string& method, const std::string& setting,
-                     double& evaluated_fraction) {
+                     double& evaluated_fraction, std::uint32_t min_sources = 2) {
     auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
-                                                  {.passes = passes, .max_passes = passes, .rows_per_task = 2});
+                                                  {.passes = passes, .max_passes = passes, .rows_per_task = 2,
+                                                   .min_sources = min_sources});
     if (!up) return fail(up.error().message()) == 0;
     sup::image img(w_, h_);
     const double t0 = now_seconds();
@@ -350,6 +529,9 @@ class harness {
   std::vector<float> ref_luma_;
   double t_full_ = 0;
   std::vector<row> rows_;
+
+ public:
+  std::string only_;
 };
 
 bool parse_int(const char* text, int lo, int hi, int& out) {
@@ -365,6 +547,8 @@ bool parse_int(const char* text, int lo, int hi, int& out) {
 
 int pareto_upsample(int argc, char** argv) {
   std::string csv;
+  bool diagnose = false;
+  std::string only;
   int width = 1025, height = 1025, threads = 0, ao = 64, soft = 16;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
@@ -373,6 +557,10 @@ int pareto_upsample(int argc, char** argv) {
       csv = argv[++i];
     } else if (a == "--size" && has2 && parse_int(argv[i + 1], 16, 16384, width) && parse_int(argv[i + 2], 16, 16384, height)) {
       i += 2;
+    } else if (a == "--only" && has1) {
+      only = argv[++i];
+    } else if (a == "--diagnose") {
+      diagnose = true;
     } else if (a == "--threads" && has1 && parse_int(argv[i + 1], 1, 1024, threads)) {
       ++i;
     } else if (a == "--ao" && has1 && parse_int(argv[i + 1], 0, 4096, ao)) {
@@ -380,11 +568,11 @@ int pareto_upsample(int argc, char** argv) {
     } else if (a == "--soft" && has1 && parse_int(argv[i + 1], 0, 4096, soft)) {
       ++i;
     } else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample --csv FILE [--size W H] [--threads N] [--ao N] [--soft N]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--size W H] [--threads N] [--ao N] [--soft N]\n");
       return 2;
     }
   }
-  if (csv.empty()) {
+  if (csv.empty() && !diagnose) {
     std::fprintf(stderr, "infolerp_pareto upsample: --csv FILE is required\n");
     return 2;
   }
@@ -401,6 +589,14 @@ int pareto_upsample(int argc, char** argv) {
   const sup::shader_options shading{.ao_rays = static_cast<unsigned>(ao), .soft_shadow_rays = static_cast<unsigned>(soft)};
   std::printf("demo scene %dx%d, AO %d rays, soft shadow %d rays, threads %d\n", width, height, ao, soft,
               threads > 0 ? threads : omp_get_max_threads());
+  const double t0 = now_seconds();
+  auto features = sup::cluster_by_features(*scene, infolerp::openmp_executor{threads});
+  if (!features) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", features.error().message().c_str());
+    return 1;
+  }
+  std::printf("feature clustering (demo thresholds): %zu clusters, %.1f s\n", features->count(), now_seconds() - t0);
   harness h(*scene, shading, width, height, threads);
-  return h.run(csv);
+  h.only_ = only;
+  return diagnose ? h.diagnose(*features) : h.run(csv, *features);
 }

@@ -122,7 +122,7 @@ shading_inputs reference_shader::evaluate_hit(const ray& primary, const hit& h, 
   };
 
   // Hard shadow: one ray toward the sun (none when the surface faces away).
-  if (glm::dot(ng, scene.sun.direction) > 0.0f) {
+  if (options_.hard_shadow && glm::dot(ng, scene.sun.direction) > 0.0f) {
     batch[count++] = ray{origin, 0.0f, scene.sun.direction};
     if (flush() == 1) in.light_bits |= sun_light_bit;
   }

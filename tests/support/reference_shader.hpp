@@ -27,6 +27,7 @@ struct shader_options {
   unsigned ao_rays = 64;           // N: ambient-occlusion rays per pixel (0 = no AO, ao = 1)
   unsigned soft_shadow_rays = 16;  // M: rays to fixed points on the area light (0 = light off)
   bool packets = false;            // trace a pixel's AO and soft-shadow rays as 16-ray packets
+  bool hard_shadow = true;         // trace the sun's hard-shadow ray (false: light_bits stay 0)
 };
 
 // What evaluate() finds at a pixel: everything shade() needs. Interpolating records (not
