@@ -5,8 +5,10 @@
 // demo's clusters stage and the time-against-error harness, so both use the same clusters.
 //   cluster_object(mesh, tracer, exec, thresholds, progress)   one mesh
 //   cluster_by_features(scene, exec, thresholds, progress, on_object)
-//       every object (positions welded first so that texture seams do not split clusters;
-//       the triangles keep their order), ids offset per object.
+//       every object (positions welded first so that the clustering sees one surface; the
+//       triangles keep their order), ids offset per object; the I-Buffer then takes
+//   split_at_texture_seams(scene, clustering)
+//       the clusters cut along texture seams (texcoords are interpolated within an id).
 // thresholds maps a channel name (visibility, orientation, stretch) to its Jensen-Shannon
 // threshold; missing ones take the demo's defaults (0.48, 0.05, 0.1). progress(label, done,
 // total) reports the visibility rays of each object; on_object(name, clustering) is called after
@@ -41,6 +43,55 @@ result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& t
                                          }},
                       orientation_channel{.threshold = th("orientation", 0.05), .bins = 256},
                       stretch_channel{.threshold = th("stretch", 0.1), .bins = 256});
+}
+
+// Splits every cluster at texture seams: the I-Buffer interpolates texcoords, which is wrong
+// across a seam (u = 0.99 and u = 0.01 average to 0.5), and the paper's models use multi-chart
+// parameterisations. Ids become the connected pieces of (cluster ∩ texture chart): triangles
+// are connected through a shared vertex index at which both have the same texcoords (the demo's
+// meshes duplicate vertices along seams). Objects without texcoords keep their clusters, split
+// into connected pieces only. O(triangles) with union-find.
+inline scene_clustering split_at_texture_seams(const demo_scene& scene, const scene_clustering& in) {
+  scene_clustering out{in.name, {}, {}};
+  for (std::uint32_t g = 0; g < scene.objects.size(); ++g) {
+    const indexed_mesh& m = scene.objects[g].mesh;
+    const auto& ids = in.ids[g];
+    const std::size_t n = m.triangle_count();
+    std::vector<std::uint32_t> parent(n);
+    for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
+    const auto find = [&](std::uint32_t t) {
+      while (parent[t] != t) t = parent[t] = parent[parent[t]];
+      return t;
+    };
+    std::vector<std::vector<std::uint32_t>> at_vertex(m.vertex_count());  // triangles per vertex
+    for (std::size_t t = 0; t < n; ++t)
+      for (unsigned k = 0; k < 3; ++k) at_vertex[m.triangles[t][static_cast<int>(k)]].push_back(static_cast<std::uint32_t>(t));
+    const auto uv_at = [&](std::uint32_t t, std::uint32_t v) {
+      for (unsigned k = 0; k < 3; ++k)
+        if (m.triangles[t][static_cast<int>(k)] == v) return m.texcoord(t, k);
+      return glm::vec2(0.0f);
+    };
+    for (std::uint32_t v = 0; v < at_vertex.size(); ++v) {
+      const auto& ts = at_vertex[v];
+      for (std::size_t i = 1; i < ts.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+          if (ids[ts[i]] != ids[ts[j]]) continue;
+          if (m.has_texcoords() && uv_at(ts[i], v) != uv_at(ts[j], v)) continue;
+          parent[find(ts[i])] = find(ts[j]);
+        }
+    }
+    std::vector<std::uint32_t> local(n), id_of_root(n, invalid_id);
+    for (std::size_t t = 0; t < n; ++t) {
+      const std::uint32_t r = find(static_cast<std::uint32_t>(t));
+      if (id_of_root[r] == invalid_id) {
+        id_of_root[r] = static_cast<std::uint32_t>(out.geometry_of.size());
+        out.geometry_of.push_back(g);
+      }
+      local[t] = id_of_root[r];
+    }
+    out.ids.push_back(std::move(local));
+  }
+  return out;
 }
 
 template <class Exec>

@@ -102,15 +102,14 @@ struct demo_ibuffer_source {
     s.lights = in.light_bits;
     s.occlusion = {in.ao, in.soft_shadow};
     if (perspective) {
-      const camera& view = shader->scene().view;
-      s.inv_depth = 1.0f / std::max(glm::dot(in.position - view.eye, glm::normalize(view.target - view.eye)), 1e-6f);
+      const pinhole_rays& view = shader->camera_rays();
+      s.inv_depth = 1.0f / std::max(glm::dot(in.position - view.eye, view.forward), 1e-6f);
     }
     return s;
   }
   shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
     shading_inputs in;
-    in.view = glm::normalize(
-        shader->scene().view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
+    in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
     if (s.background()) return in;
     in.position = s.position;
     const float len = glm::length(s.normal);
