@@ -17,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 #include "infolerp/cluster/cluster_mesh.hpp"
 #include "support/demo_scene.hpp"
@@ -50,45 +51,47 @@ result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& t
 // parameterisations. Ids become the connected pieces of (cluster ∩ texture chart): triangles
 // are connected through a shared vertex index at which both have the same texcoords (the demo's
 // meshes duplicate vertices along seams). Objects without texcoords keep their clusters, split
-// into connected pieces only. O(triangles) with union-find.
+// into connected pieces only. O(triangles) with union-find. A cluster that reaches around a
+// seam (connected the other way round, e.g. a whole UV sphere) stays one id: a limitation.
+// One mesh: ids[t] -> new ids 0..count-1 (returned in out), the count returned.
+inline std::uint32_t split_at_texture_seams(const indexed_mesh& m, const std::vector<std::uint32_t>& ids,
+                                            std::vector<std::uint32_t>& out) {
+  const std::size_t n = m.triangle_count();
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
+  const auto find = [&](std::uint32_t t) {
+    while (parent[t] != t) t = parent[t] = parent[parent[t]];
+    return t;
+  };
+  std::vector<std::vector<std::pair<std::uint32_t, glm::vec2>>> at_vertex(m.vertex_count());  // (triangle, uv)
+  for (std::size_t t = 0; t < n; ++t)
+    for (unsigned k = 0; k < 3; ++k)
+      at_vertex[m.triangles[t][static_cast<int>(k)]].push_back(
+          {static_cast<std::uint32_t>(t), m.has_texcoords() ? m.texcoord(t, k) : glm::vec2(0.0f)});
+  for (const auto& ts : at_vertex)
+    for (std::size_t i = 1; i < ts.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (ids[ts[i].first] == ids[ts[j].first] && ts[i].second == ts[j].second)
+          parent[find(ts[i].first)] = find(ts[j].first);
+  out.assign(n, invalid_id);
+  std::vector<std::uint32_t> id_of_root(n, invalid_id);
+  std::uint32_t count = 0;
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::uint32_t r = find(static_cast<std::uint32_t>(t));
+    if (id_of_root[r] == invalid_id) id_of_root[r] = count++;
+    out[t] = id_of_root[r];
+  }
+  return count;
+}
+
 inline scene_clustering split_at_texture_seams(const demo_scene& scene, const scene_clustering& in) {
   scene_clustering out{in.name, {}, {}};
   for (std::uint32_t g = 0; g < scene.objects.size(); ++g) {
-    const indexed_mesh& m = scene.objects[g].mesh;
-    const auto& ids = in.ids[g];
-    const std::size_t n = m.triangle_count();
-    std::vector<std::uint32_t> parent(n);
-    for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
-    const auto find = [&](std::uint32_t t) {
-      while (parent[t] != t) t = parent[t] = parent[parent[t]];
-      return t;
-    };
-    std::vector<std::vector<std::uint32_t>> at_vertex(m.vertex_count());  // triangles per vertex
-    for (std::size_t t = 0; t < n; ++t)
-      for (unsigned k = 0; k < 3; ++k) at_vertex[m.triangles[t][static_cast<int>(k)]].push_back(static_cast<std::uint32_t>(t));
-    const auto uv_at = [&](std::uint32_t t, std::uint32_t v) {
-      for (unsigned k = 0; k < 3; ++k)
-        if (m.triangles[t][static_cast<int>(k)] == v) return m.texcoord(t, k);
-      return glm::vec2(0.0f);
-    };
-    for (std::uint32_t v = 0; v < at_vertex.size(); ++v) {
-      const auto& ts = at_vertex[v];
-      for (std::size_t i = 1; i < ts.size(); ++i)
-        for (std::size_t j = 0; j < i; ++j) {
-          if (ids[ts[i]] != ids[ts[j]]) continue;
-          if (m.has_texcoords() && uv_at(ts[i], v) != uv_at(ts[j], v)) continue;
-          parent[find(ts[i])] = find(ts[j]);
-        }
-    }
-    std::vector<std::uint32_t> local(n), id_of_root(n, invalid_id);
-    for (std::size_t t = 0; t < n; ++t) {
-      const std::uint32_t r = find(static_cast<std::uint32_t>(t));
-      if (id_of_root[r] == invalid_id) {
-        id_of_root[r] = static_cast<std::uint32_t>(out.geometry_of.size());
-        out.geometry_of.push_back(g);
-      }
-      local[t] = id_of_root[r];
-    }
+    std::vector<std::uint32_t> local;
+    const std::uint32_t count = split_at_texture_seams(scene.objects[g].mesh, in.ids[g], local);
+    const auto offset = static_cast<std::uint32_t>(out.geometry_of.size());
+    for (auto& k : local) k += offset;
+    out.geometry_of.insert(out.geometry_of.end(), count, g);
     out.ids.push_back(std::move(local));
   }
   return out;
