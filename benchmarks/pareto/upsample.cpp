@@ -209,19 +209,24 @@ class harness {
         po.hard_shadow = probe_lights;
         const sup::reference_shader primary(scene_, po);
         // min_sources 1 needs probes that carry everything compatible() tests (a single source
-        // cannot vouch for the sun bit), so only with probe_lights.
-        for (std::uint32_t min_sources = probe_lights ? 1u : 2u; min_sources <= 2; ++min_sources)
-          for (std::uint32_t passes = 3; passes <= 6; ++passes) {
-            sup::demo_probe_source src;
-            static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &features, w_, h_};
-            src.primary = &primary;
-            src.probe_lights = probe_lights;
-            double f = 0;
-            char setting[128];
-            std::snprintf(setting, sizeof setting, "feature (%zu), probe primary%s, min %u src, %u passes", features.count(),
-                          probe_lights ? "+sun" : "", min_sources, passes);
-            if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
-          }
+        // cannot vouch for the sun bit), so only with probe_lights. The coarser clusterings
+        // only with the fastest setting.
+        std::vector<const sup::scene_clustering*> with{&features};
+        if (probe_lights)
+          for (const auto& c : coarser) with.push_back(&c);
+        for (const sup::scene_clustering* c : with)
+          for (std::uint32_t min_sources = probe_lights ? 1u : 2u; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
+            for (std::uint32_t passes = c == &features ? 3 : 4; passes <= 6; ++passes) {
+              sup::demo_probe_source src;
+              static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+              src.primary = &primary;
+              src.probe_lights = probe_lights;
+              double f = 0;
+              char setting[128];
+              std::snprintf(setting, sizeof setting, "%s (%zu), probe primary%s, min %u src, %u passes", c->name.c_str(),
+                            c->count(), probe_lights ? "+sun" : "", min_sources, passes);
+              if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+            }
       }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.

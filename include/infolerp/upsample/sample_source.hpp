@@ -6,6 +6,10 @@
 // of occluded samples for soft shadows and ambient occlusion (§4), and hard-shadow light bits
 // "compacted in a single integer value" (§4.1). Texture coordinates are interpolated, never the
 // textured colours (§5, Fig. 12), so a sample becomes a colour only after interpolation.
+// Beyond the paper: the default record's interpolation is perspective-correct when the engine
+// fills inv_depth (1 / view depth): the paper's screen-linear weights misplace texcoords on
+// surfaces seen at an angle, which was the largest error on the demo scene (measured there,
+// 1025², 506 feature clusters, 4 passes: 39.8 dB screen-linear, 42.1 dB perspective-correct).
 //
 // A sample source S models:
 //   typename S::sample_type                               the I-Buffer record (copyable)
@@ -32,8 +36,7 @@
 //        and whatever comes with it cheaply (position, normal, texcoords, hard-shadow bits);
 //        the expensive terms (occlusion) left unset
 //   sample_type interpolate(const sample_type& probe, a, b)        the probe with the expensive
-//   sample_type interpolate(const sample_type& probe, a, b, c, d)  terms of a, b (weights 1/2)
-//                                                                  or a..d (1/4)
+//   sample_type interpolate(const sample_type& probe, a, b, c, d)  terms of a, b or a..d
 // (members, or free functions found by ADL; the default record has them), and optionally
 //   bool probe_compatible(const sample_type& probe, const sample_type& s)   may s complete probe?
 // (member or ADL; default compatible(probe, s)), for probes that leave out part of what

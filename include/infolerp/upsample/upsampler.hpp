@@ -68,7 +68,9 @@ struct upsampler_options {
   bool record_kinds = true;         // keep the R/I/E kind of every pixel of the last pass (kinds())
   bool keep_ibuffer = false;        // keep the last pass's samples (ibuffer()); off: shade straight into the frame
   std::uint32_t min_sources = 2;    // sources with probes only: fewest sources compatible with a new sample's
-                                    // probe that it is interpolated from (1 or 2; else it is evaluated)
+                                    // probe that it is interpolated from (1 or 2; else it is evaluated). 1 only
+                                    // for probes that carry all compatible() tests: one source cannot be
+                                    // checked against another
 };
 
 // Statistics of one pass.
@@ -414,8 +416,9 @@ class upsampler {
       const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
       unsigned mask = 0;
       for (unsigned k = 0; k < 4; ++k) mask |= detail::may_complete(src, p, *c[k]) ? 1u << k : 0u;
-      if (cross_check && mask == 0xF && !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
-                           detail::may_interpolate(src, *c[0], *c[3])))
+      if (cross_check && mask == 0xF &&
+          !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
+            detail::may_interpolate(src, *c[0], *c[3])))
         mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out): evaluate
       const Sample* s0 = nullptr;
       const Sample* s1 = nullptr;
