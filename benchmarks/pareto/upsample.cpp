@@ -216,7 +216,7 @@ class harness {
           for (const auto& c : coarser) with.push_back(&c);
         for (const sup::scene_clustering* c : with)
           for (std::uint32_t min_sources = probe_lights ? 1u : 2u; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
-            for (std::uint32_t passes = c == &features ? 3 : 4; passes <= 6; ++passes) {
+            for (std::uint32_t passes = c != &features ? 4 : probe_lights && min_sources == 2 ? 2 : 3; passes <= 6; ++passes) {
               sup::demo_probe_source src;
               static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
               src.primary = &primary;
