@@ -25,11 +25,11 @@
 // R samples keep their probe), so a probe must be much cheaper than an evaluation to pay off.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// sun, 2 threads, process CPU time, least of 3 runs; full per-pixel evaluation 3.26 s):
-//   plain, demo thresholds (518 ids):     4 passes 8.8x 45.7 dB, 5 passes 9.3x 44.0 dB
-//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.3x 42.9 dB, 5 passes 12.9x 40.5 dB
-//   probes, 518 ids, min_sources 1:       4 passes 10.2x 54.3 dB, 5 passes 11.4x 50.4 dB
-//   probes, 131 ids, min_sources 1:       5 passes 13.1x 49.0 dB, 6 passes 13.8x 44.7 dB
+// sun, 2 threads, process CPU time, least of 3 runs; full per-pixel evaluation 3.23 s):
+//   plain, demo thresholds (518 ids):     4 passes 8.4x 45.7 dB, 5 passes 9.0x 44.0 dB
+//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 12.9x 40.5 dB
+//   probes, 518 ids, min_sources 1:       4 passes 10.4x 54.3 dB, 5 passes 11.7x 50.4 dB
+//   probes, 131 ids, min_sources 1:       5 passes 12.8x 49.0 dB, 6 passes 13.4x 44.7 dB
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
 // BM_UpsampleInterpolatedPixel) is 9–15 ns per interpolated pixel, 19 ns with probes (the
 // probe included).
