@@ -1,6 +1,7 @@
 // Cost of the I-Buffer upsampler's own work (issue 6): interpolation, re-use, compatibility tests,
 // shading into the frame buffer, with a cheap synthetic sample source so that evaluation costs
-// almost nothing. Goal: at most 20 ns per interpolated pixel on one core.
+// almost nothing. Goal: at most 20 ns per interpolated pixel on one core. The cheap_probe_source
+// rows add a probe per new sample (as cheap as the evaluation here).
 //   ns_per_interpolated = frame time / interpolated samples (all passes; conservative: the frame
 //                         time also pays for the few evaluated and the re-used samples)
 //   ns_per_pixel        = frame time / output pixels
@@ -35,6 +36,13 @@ struct cheap_source {
   }
 };
 
+// The same with probes: every new sample probes its pixel (here as cheap as evaluate) and is
+// completed from the sources that match it.
+struct cheap_probe_source : cheap_source {
+  sample probe(std::uint32_t x, std::uint32_t y) const { return evaluate(x, y); }
+};
+
+template <class Source>
 void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
   const auto passes = static_cast<std::uint32_t>(state.range(0));
   constexpr std::uint32_t w = 1025, h = 1025;
@@ -44,7 +52,7 @@ void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
     return;
   }
   std::vector<glm::vec4> frame(static_cast<std::size_t>(w) * h);
-  const cheap_source src;
+  const Source src;
   for (auto _ : state) {
     auto s = up->render(src, std::span<glm::vec4>(frame));
     benchmark::DoNotOptimize(frame.data());
@@ -60,7 +68,8 @@ void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
   state.counters["ns_per_pixel"] = benchmark::Counter(static_cast<double>(w) * h * frames,
                                                       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_UpsampleInterpolatedPixel)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_source)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_probe_source)->Arg(4)->Unit(benchmark::kMillisecond);
 
 // Plain per-pixel evaluation of the same cheap source (passes = 1), for comparison.
 void BM_UpsamplePlainEvaluation(benchmark::State& state) {

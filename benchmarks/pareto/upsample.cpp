@@ -1,4 +1,5 @@
-// infolerp_pareto upsample --csv FILE [--size W H] [--threads N] [--ao N] [--soft N]
+// infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--repeat N]
+//                          [--size W H] [--threads N] [--ao N] [--soft N]
 //
 // Time against error of the I-Buffer upsampler (issue 6) and its competitors on the demo scene
 // (1025x1025 by default) with the reference shader (AO 64 rays, soft shadow 16 rays, hard-shadow
@@ -6,23 +7,35 @@
 //   full_single       full per-pixel evaluation, single rays (the reference, error 0)
 //   full_packets16    full per-pixel evaluation, AO and soft-shadow rays in 16-ray packets
 //   lowres_bilinear   a uniform coarse grid, fully shaded, bilinear colours; grid sized so that it
-//                     evaluates as many samples as the I-Buffer does (matched cost)
+//                     evaluates as many samples as the I-Buffer (feature clusters) does (matched cost)
 //   joint_bilateral   primary ray + hard shadow at every pixel, AO and soft shadow on a coarse
 //                     grid, joint-bilateral (same object, normal, depth) interpolation of those
 //   contrast          the I-Buffer pass schedule deciding by a luminance-contrast test instead
 //                     of cluster ids
-//   ibuffer           the I-Buffer, 1-5 passes, several clusterings (STAND-IN clusterings, see
-//                     tests/support/demo_upsample.hpp, until include/infolerp/cluster lands)
+//   ibuffer           the I-Buffer, 1-5 passes: the real feature clustering of the demo
+//                     (support::cluster_by_features, the demo's thresholds) and three stand-ins
+//                     (tests/support/demo_upsample.hpp); perspective-correct weights
+//   ibuffer_linear    the same with the paper's screen-linear weights (inv_depth = 1)
+//   ibuffer_probe     the I-Buffer with probes: the primary hit (and the sun ray, "+sun") at every
+//                     pixel, AO and soft shadow interpolated from the sources matching the new
+//                     sample's own cluster id (min_sources 1 or 2)
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
-// Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim)
-// and FILE.png: PSNR against time (gnuplot), with FILE.gp/FILE.dat next to it.
+// Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
+// subset (the reference always runs). --diagnose prints where the I-Buffer's error and time go
+// (feature clusters, 3 and 4 passes) instead of writing a CSV.
+// Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,
+// cpu_seconds,cpu_speedup_vs_full_single: wall and process CPU time, each the least of N runs)
+// and FILE.png: PSNR against CPU time (gnuplot), with FILE.gp/FILE.dat next to it. For CPU
+// times that mean something, run with OMP_WAIT_POLICY=passive (no spinning OpenMP workers).
 #include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <atomic>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -33,6 +46,7 @@
 #include <omp.h>
 #include "infolerp/upsample/upsampler.hpp"
 #include "pareto.hpp"
+#include "support/demo_clusters.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
@@ -49,6 +63,28 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// CPU time of the whole process (all threads): less sensitive than wall time to the other
+// processes of a shared machine. Run with OMP_WAIT_POLICY=passive, or OpenMP's spinning
+// workers count too.
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The least wall and CPU time over repeated runs.
+struct stopwatch {
+  double wall = 1e30, cpu = 1e30, wall0 = 0, cpu0 = 0;
+  void start() {
+    wall0 = now_seconds();
+    cpu0 = cpu_seconds();
+  }
+  void stop() {
+    wall = std::min(wall, now_seconds() - wall0);
+    cpu = std::min(cpu, cpu_seconds() - cpu0);
+  }
+};
+
 std::vector<float> luma_of(const sup::image& img) {
   std::vector<float> l(img.pixels.size());
   for (std::size_t i = 0; i < l.size(); ++i) l[i] = sup::display_luma(img.pixels[i]);
@@ -57,7 +93,7 @@ std::vector<float> luma_of(const sup::image& img) {
 
 struct row {
   std::string method, setting;
-  double seconds = 0, evaluated_fraction = 0, psnr = 0, ssim = 0;
+  double seconds = 0, cpu_seconds = 0, evaluated_fraction = 0, psnr = 0, ssim = 0;
 };
 
 // The contrast competitor: the same pass schedule and record, but two samples may be
@@ -105,56 +141,110 @@ class harness {
   harness(const sup::demo_scene& scene, const sup::shader_options& shading, int width, int height, int threads)
       : scene_(scene), shading_(shading), single_(scene, shading), w_(width), h_(height), threads_(threads) {}
 
-  int run(const std::string& csv_path) {
+  // features: the feature clustering at the demo's thresholds; coarser: at other thresholds.
+  int run(const std::string& csv_path, const sup::scene_clustering& features, const std::vector<sup::scene_clustering>& coarser) {
     // (1) the reference: full per-pixel evaluation with single rays.
     {
-      const double t0 = now_seconds();
-      auto st = sup::render_reference(single_, w_, h_, reference_, threads_);
-      if (!st) return fail(st.error().message());
-      t_full_ = now_seconds() - t0;
+      stopwatch sw;
+      for (int rep = 0; rep < repeat_; ++rep) {
+        sw.start();
+        auto st = sup::render_reference(single_, w_, h_, reference_, threads_);
+        if (!st) return fail(st.error().message());
+        sw.stop();
+      }
+      t_full_ = sw.wall;
+      cpu_full_ = sw.cpu;
       ref_luma_ = luma_of(reference_);
-      add("full_single", "1 ray per call", t_full_, 1.0, reference_);
+      add("full_single", "1 ray per call", sw, 1.0, reference_);
     }
     // (2) 16-ray packets.
-    {
+    if (want("full_packets16")) {
       sup::shader_options o = shading_;
       o.packets = true;
       const sup::reference_shader packets(scene_, o);
       sup::image img;
-      const double t0 = now_seconds();
-      auto st = sup::render_reference(packets, w_, h_, img, threads_);
-      if (!st) return fail(st.error().message());
-      add("full_packets16", "AO+soft shadow rays in 16-ray packets", now_seconds() - t0, 1.0, img);
+      stopwatch sw;
+      for (int rep = 0; rep < repeat_; ++rep) {
+        sw.start();
+        auto st = sup::render_reference(packets, w_, h_, img, threads_);
+        if (!st) return fail(st.error().message());
+        sw.stop();
+      }
+      add("full_packets16", "AO+soft shadow rays in 16-ray packets", sw, 1.0, img);
     }
     // (6) the I-Buffer with several clusterings and 1-5 passes.
     std::vector<sup::scene_clustering> clusterings;
     clusterings.push_back(sup::cluster_by_object(scene_));
     for (int cells : {1, 2, 4}) clusterings.push_back(sup::cluster_by_normal(scene_, cells));
-    std::vector<double> matched_fraction(6, 1.0);  // evaluated fraction of the finest stand-in, per passes
+    clusterings.insert(clusterings.end(), coarser.begin(), coarser.end());
+    clusterings.push_back(features);
+    std::vector<double> matched_fraction(7, 1.0);  // evaluated fraction of the feature clustering, per passes
     for (const auto& c : clusterings) {
-      for (std::uint32_t passes = 1; passes <= 5; ++passes) {
+      // One pass (plain evaluation through the upsampler) only for the feature clustering; 6
+      // passes only for the feature clusterings.
+      const bool feature = c.name.starts_with("feature");
+      for (std::uint32_t passes = &c == &clusterings.back() ? 1 : 2; passes <= (feature ? 6u : 5u) && want("ibuffer"); ++passes) {
         const sup::demo_ibuffer_source src{&single_, &c, w_, h_};
         double f = 0;
         if (!run_upsampler<sample>(src, passes, "ibuffer",
                                    c.name + " (" + std::to_string(c.count()) + " clusters), " + std::to_string(passes) + " passes", f))
           return 1;
-        if (c.name == "normal2") matched_fraction[passes] = f;
+        if (&c == &clusterings.back()) matched_fraction[passes] = f;
+      }
+    }
+    // (6a) the feature clustering with screen-linear weights (the paper's interpolation).
+    for (std::uint32_t passes = 2; passes <= 5 && want("ibuffer_linear"); ++passes) {
+      const sup::demo_ibuffer_source src{&single_, &features, w_, h_, false};
+      double f = 0;
+      if (!run_upsampler<sample>(src, passes, "ibuffer_linear",
+                                 "feature (" + std::to_string(features.count()) + " clusters), screen-linear weights, " + std::to_string(passes) + " passes", f))
+        return 1;
+    }
+    // (6c) the I-Buffer with probes: primary hit + sun at every pixel, AO and soft shadow interpolated.
+    if (want("ibuffer_probe")) {
+      for (bool probe_lights : {false, true}) {
+        sup::shader_options po = shading_;
+        po.ao_rays = 0;
+        po.soft_shadow_rays = 0;
+        po.hard_shadow = probe_lights;
+        const sup::reference_shader primary(scene_, po);
+        // min_sources 1 needs probes that carry everything compatible() tests (a single source
+        // cannot vouch for the sun bit), so only with probe_lights. The coarser clusterings
+        // only with the fastest setting.
+        std::vector<const sup::scene_clustering*> with{&features};
+        if (probe_lights)
+          for (const auto& c : coarser) with.push_back(&c);
+        for (const sup::scene_clustering* c : with)
+          for (std::uint32_t min_sources = probe_lights ? 1u : 2u; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
+            for (std::uint32_t passes = c != &features ? 4 : probe_lights && min_sources == 2 ? 2 : 3; passes <= 6; ++passes) {
+              sup::demo_probe_source src;
+              static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+              src.primary = &primary;
+              src.probe_lights = probe_lights;
+              double f = 0;
+              char setting[128];
+              std::snprintf(setting, sizeof setting, "%s (%zu), probe primary%s, min %u src, %u passes", c->name.c_str(),
+                            c->count(), probe_lights ? "+sun" : "", min_sources, passes);
+              if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+            }
       }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {
+      if (!want("ibuffer_occl")) break;
       for (std::uint32_t passes = 3; passes <= 5; ++passes) {
         occlusion_checked_source src;
-        static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusterings[2], w_, h_};
+        static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &features, w_, h_};
         src.tolerance = tolerance;
         double f = 0;
         char setting[96];
-        std::snprintf(setting, sizeof setting, "normal2 + |dAO|,|dsoft| <= %.2f, %u passes", static_cast<double>(tolerance), passes);
+        std::snprintf(setting, sizeof setting, "feature + |dAO|,|dsoft| <= %.2f, %u passes", static_cast<double>(tolerance), passes);
         if (!run_upsampler<sample>(src, passes, "ibuffer_occl", setting, f)) return 1;
       }
     }
     // (5) the same schedule deciding by luminance contrast.
     for (float threshold : {0.02f, 0.05f}) {
+      if (!want("contrast")) break;
       for (std::uint32_t passes = 2; passes <= 5; ++passes) {
         const contrast_source src{{&single_, &clusterings[0], w_, h_}, threshold};
         double f = 0;
@@ -164,40 +254,188 @@ class harness {
       }
     }
     // (3) uniform low resolution + bilinear at the I-Buffer's evaluated fraction.
-    for (std::uint32_t passes = 2; passes <= 5; ++passes) lowres_bilinear(matched_fraction[passes], passes);
+    for (std::uint32_t passes = 2; passes <= 6 && want("lowres_bilinear"); ++passes) lowres_bilinear(matched_fraction[passes], passes);
     // (4) joint-bilateral upsampling of the expensive terms from a 2^(p-1) grid.
-    for (std::uint32_t passes = 2; passes <= 5; ++passes) joint_bilateral(1 << (passes - 1));
+    for (std::uint32_t passes = 2; passes <= 5 && want("joint_bilateral"); ++passes) joint_bilateral(1 << (passes - 1));
     return write(csv_path);
   }
 
+
+  // --diagnose: where the I-Buffer's error and time go, for the feature clustering at 3 and 4
+  // passes. Error: PSNR of the I-Buffer frame with one group of its record replaced by the
+  // reference's values at every pixel (what is left is the other groups' error), and the
+  // squared-error share of evaluated / interpolated / reused pixels. Time: evaluate() calls
+  // (timed inside the source), shading of the final I-Buffer alone, the rest (R/I decisions,
+  // interpolation, copies, bookkeeping); and the per-pixel cost of a full evaluation, of a
+  // primary ray + sun ray, and of a primary ray alone.
+  int diagnose(const sup::scene_clustering& clusters) {
+    const std::size_t n = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
+    const int nthreads = threads_ > 0 ? threads_ : omp_get_max_threads();
+    std::vector<sup::shading_inputs> ref(n);
+    sup::image refimg(w_, h_);
+    double t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        std::uint64_t rays = 0;
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+        ref[i] = single_.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays);
+        refimg.pixels[i] = single_.shade(ref[i]);
+      }
+    const double t_full = now_seconds() - t0;
+    sup::shader_options po = shading_;
+    po.ao_rays = 0;
+    po.soft_shadow_rays = 0;
+    const sup::reference_shader primary(scene_, po);
+    double sink = 0;
+    t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads) reduction(+ : sink)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        std::uint64_t rays = 0;
+        sink += static_cast<double>(primary.evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_, rays).normal.x);
+      }
+    const double t_primary_sun = now_seconds() - t0;
+    t0 = now_seconds();
+#pragma omp parallel for schedule(dynamic, 2) num_threads(nthreads) reduction(+ : sink)
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x)
+        sink += scene_.tracer.intersect(scene_.view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w_, h_)).valid() ? 1.0 : 0.0;
+    const double t_primary = now_seconds() - t0;
+    std::printf("per-pixel cost (%d threads, wall): full %.0f ns, primary+sun %.0f ns (%.3f of full), primary %.0f ns (%.3f of full)  [%g]\n",
+                nthreads, 1e9 * t_full / static_cast<double>(n), 1e9 * t_primary_sun / static_cast<double>(n), t_primary_sun / t_full,
+                1e9 * t_primary / static_cast<double>(n), t_primary / t_full, sink > 0 ? 1.0 : 0.0);
+
+    struct timed_source : sup::demo_ibuffer_source {
+      std::atomic<long long>* eval_ns = nullptr;
+      sample evaluate(std::uint32_t x, std::uint32_t y) const {
+        const auto a = std::chrono::steady_clock::now();
+        sample s = sup::demo_ibuffer_source::evaluate(x, y);
+        *eval_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - a).count();
+        return s;
+      }
+    };
+    for (std::uint32_t passes : {3u, 4u}) {
+      std::atomic<long long> eval_ns{0};
+      timed_source src;
+      static_cast<sup::demo_ibuffer_source&>(src) = {&single_, &clusters, w_, h_};
+      src.eval_ns = &eval_ns;
+      auto up = infolerp::upsampler<sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
+                                                    {.passes = passes, .max_passes = passes, .rows_per_task = 2, .keep_ibuffer = true});
+      if (!up) return fail(up.error().message());
+      sup::image img(w_, h_);
+      if (auto s = up->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads_}); !s) return fail(s.message());
+      const auto& st = up->stats();
+      const auto buf = up->ibuffer();
+      sup::image shaded(w_, h_);
+      t0 = now_seconds();
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+      for (int y = 0; y < h_; ++y)
+        for (int x = 0; x < w_; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+          shaded.pixels[i] = src.shade(buf[i], static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y));
+        }
+      const double t_shade = now_seconds() - t0;
+      const double t_eval = 1e-9 * static_cast<double>(eval_ns.load()) / nthreads;
+      std::printf("\n%u passes, %s (%zu clusters): frame %.3f s (x%.2f), evaluated %.4f, PSNR %.2f dB\n", passes,
+                  clusters.name.c_str(), clusters.count(), st.seconds, t_full / st.seconds, st.evaluated_fraction(), *sup::psnr(refimg, img));
+      std::printf("  time: evaluate %.3f s (%.0f%%; %.0f ns per evaluation per thread), shade %.3f s (%.0f%%), rest (R/I tests, interpolation) %.3f s (%.0f%%)\n",
+                  t_eval, 100 * t_eval / st.seconds, 1e9 * t_eval * nthreads / static_cast<double>(st.evaluated()), t_shade,
+                  100 * t_shade / st.seconds, st.seconds - t_eval - t_shade, 100 * (st.seconds - t_eval - t_shade) / st.seconds);
+      for (std::uint32_t p = 0; p < st.passes; ++p)
+        std::printf("  pass %u: %ux%u R %zu I %zu E %zu %.3f s\n", p + 1, st.pass[p].width, st.pass[p].height, st.pass[p].reused,
+                    st.pass[p].interpolated, st.pass[p].evaluated, st.pass[p].seconds);
+      // Error groups: replace one group by the reference at every pixel.
+      enum group { geometry, normal, texcoord, lights, occlusion, count };
+      const char* names[] = {"object/position", "normal", "texcoords", "sun bit", "AO+soft"};
+      auto variant = [&](int fixed_mask) {
+        sup::image v(w_, h_);
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+        for (int y = 0; y < h_; ++y)
+          for (int x = 0; x < w_; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
+            sup::shading_inputs in = src.to_inputs(buf[i], static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y));
+            const sup::shading_inputs& r = ref[i];
+            if (r.hit() != in.hit() || ((fixed_mask & (1 << geometry)) && r.hit())) {
+              if (r.hit() != in.hit()) in = r;
+              in.geometry = r.geometry;
+              in.position = r.position;
+            }
+            if (r.hit() && in.hit()) {
+              if (fixed_mask & (1 << normal)) in.normal = r.normal;
+              if (fixed_mask & (1 << texcoord)) in.uv = r.uv;
+              if ((fixed_mask & (1 << count)) && glm::length(in.uv - r.uv) > 0.05f) in.uv = r.uv;  // only texcoord jumps (seams)
+              if (fixed_mask & (1 << lights)) in.light_bits = r.light_bits;
+              if (fixed_mask & (1 << occlusion)) {
+                in.ao = r.ao;
+                in.soft_shadow = r.soft_shadow;
+              }
+            }
+            v.pixels[i] = single_.shade(in);
+          }
+        return *sup::psnr(refimg, v);
+      };
+      std::printf("  PSNR with one group exact (the rest as interpolated):");
+      for (int g = 0; g < count; ++g) std::printf(" %s %.2f,", names[g], variant(1 << g));
+      std::printf("\n  PSNR with only one group interpolated (the rest exact):");
+      for (int g = 0; g < count; ++g) std::printf(" %s %.2f,", names[g], variant(((1 << count) - 1) & ~(1 << g)));
+      std::printf("\n  PSNR with texcoords exact where they are off by > 0.05 (seams), the rest as interpolated: %.2f", variant(1 << count));
+      std::printf("\n  PSNR with exact primary hit + sun (object, position, normal, texcoords, sun bit), AO+soft as interpolated: %.2f\n",
+                  variant(((1 << count) - 1) & ~(1 << occlusion)));
+      // Squared error by kind.
+      std::array<double, 3> se{}, cnt{};
+      const auto kinds = up->kinds();
+      for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 d = glm::clamp(img.pixels[i], 0.0f, 1.0f) - glm::clamp(refimg.pixels[i], 0.0f, 1.0f);
+        se[static_cast<std::size_t>(kinds[i])] += static_cast<double>(glm::dot(d, d));
+        cnt[static_cast<std::size_t>(kinds[i])] += 1;
+      }
+      const double tot = se[0] + se[1] + se[2];
+      std::printf("  squared-error share (linear, clamped): E %.1f%% of %g px, I %.1f%% of %g px, R %.1f%% of %g px\n", 100 * se[0] / tot,
+                  cnt[0], 100 * se[1] / tot, cnt[1], 100 * se[2] / tot, cnt[2]);
+    }
+    return 0;
+  }
+
  private:
+  // --only METHOD[,METHOD...]: run only these methods (and the reference).
+  bool want(const std::string& method) const {
+    if (only_.empty()) return true;
+    return ("," + only_ + ",").find("," + method + ",") != std::string::npos;
+  }
+
   static int fail(const std::string& message) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", message.c_str());
     return 1;
   }
 
-  void add(const std::string& method, const std::string& setting, double seconds, double evaluated_fraction,
+  void add(const std::string& method, const std::string& setting, const stopwatch& time, double evaluated_fraction,
            const sup::image& img) {
-    row r{method, setting, seconds, evaluated_fraction, 0, 0};
+    row r{method, setting, time.wall, time.cpu, evaluated_fraction, 0, 0};
     r.psnr = *sup::psnr(reference_, img);
     r.ssim = *sup::ssim(ref_luma_, luma_of(img), w_, h_);
-    std::printf("%-16s %-48s %8.3f s  x%6.2f  eval %.4f  PSNR %6.2f dB  SSIM %.5f\n", method.c_str(), setting.c_str(),
-                seconds, t_full_ / seconds, evaluated_fraction, r.psnr, r.ssim);
+    std::printf("%-16s %-56s %7.3f s x%6.2f  cpu %7.3f s x%6.2f  eval %.4f  PSNR %6.2f dB  SSIM %.5f\n", method.c_str(),
+                setting.c_str(), time.wall, t_full_ / time.wall, time.cpu, cpu_full_ / time.cpu, evaluated_fraction, r.psnr,
+                r.ssim);
     std::fflush(stdout);
     rows_.push_back(r);
   }
 
   template <class Sample, class Source>
   bool run_upsampler(const Source& src, std::uint32_t passes, const std::string& method, const std::string& setting,
-                     double& evaluated_fraction) {
+                     double& evaluated_fraction, std::uint32_t min_sources = 2) {
     auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
-                                                  {.passes = passes, .max_passes = passes, .rows_per_task = 2});
+                                                  {.passes = passes, .max_passes = passes, .rows_per_task = 2,
+                                                   .min_sources = min_sources});
     if (!up) return fail(up.error().message()) == 0;
     sup::image img(w_, h_);
-    const double t0 = now_seconds();
-    auto s = up->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads_});
-    const double t = now_seconds() - t0;
-    if (!s) return fail(s.message()) == 0;
+    stopwatch t;
+    for (int rep = 0; rep < repeat_; ++rep) {
+      t.start();
+      auto s = up->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads_});
+      t.stop();
+      if (!s) return fail(s.message()) == 0;
+    }
     evaluated_fraction = up->stats().evaluated_fraction();
     add(method, setting, t, evaluated_fraction, img);
     return true;
@@ -212,7 +450,9 @@ class harness {
     const float sy = static_cast<float>(h_ - 1) / static_cast<float>(gh - 1);
     std::vector<glm::vec3> grid(static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh));
     sup::image img(w_, h_);
-    const double t0 = now_seconds();
+    stopwatch t;
+    for (int rep = 0; rep < repeat_; ++rep) {
+    t.start();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads_ > 0 ? threads_ : omp_get_max_threads())
     for (int j = 0; j < gh; ++j)
       for (int i = 0; i < gw; ++i) {
@@ -233,9 +473,10 @@ class harness {
         img.at(x, y) = (1 - fy) * ((1 - fx) * g(i, j) + fx * g(i + 1, j)) + fy * ((1 - fx) * g(i, j + 1) + fx * g(i + 1, j + 1));
       }
     }
-    const double t = now_seconds() - t0;
+    t.stop();
+    }
     char setting[96];
-    std::snprintf(setting, sizeof setting, "%dx%d grid (matches ibuffer normal2, %u passes)", gw, gh, passes);
+    std::snprintf(setting, sizeof setting, "%dx%d grid (matches ibuffer feature, %u passes)", gw, gh, passes);
     add("lowres_bilinear", setting, t, static_cast<double>(grid.size()) / (static_cast<double>(w_) * h_), img);
   }
 
@@ -251,7 +492,10 @@ class harness {
     const int nthreads = threads_ > 0 ? threads_ : omp_get_max_threads();
     long long fallbacks = 0;
     const glm::vec3 eye = scene_.view.eye;
-    const double t0 = now_seconds();
+    stopwatch t;
+    for (int rep = 0; rep < repeat_; ++rep) {
+    fallbacks = 0;
+    t.start();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int j = 0; j < gh; ++j)
       for (int i = 0; i < gw; ++i) {
@@ -296,7 +540,8 @@ class harness {
         img.at(x, y) = single_.shade(in);
       }
     }
-    const double t = now_seconds() - t0;
+    t.stop();
+    }
     char setting[96];
     std::snprintf(setting, sizeof setting, "AO+soft on a 1/%d grid, primary+sun per pixel", step);
     add("joint_bilateral", setting, t,
@@ -306,11 +551,11 @@ class harness {
   int write(const std::string& csv_path) {
     std::ofstream csv(csv_path);
     if (!csv) return fail("cannot write " + csv_path);
-    csv << "method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim\n";
+    csv << "method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,cpu_seconds,cpu_speedup_vs_full_single\n";
     char line[512];
     for (const auto& r : rows_) {
-      std::snprintf(line, sizeof line, "%s,\"%s\",%.6f,%.4f,%.6f,%.4f,%.6f\n", r.method.c_str(), r.setting.c_str(),
-                    r.seconds, t_full_ / r.seconds, r.evaluated_fraction, r.psnr, r.ssim);
+      std::snprintf(line, sizeof line, "%s,\"%s\",%.6f,%.4f,%.6f,%.4f,%.6f,%.6f,%.4f\n", r.method.c_str(), r.setting.c_str(),
+                    r.seconds, t_full_ / r.seconds, r.evaluated_fraction, r.psnr, r.ssim, r.cpu_seconds, cpu_full_ / r.cpu_seconds);
       csv << line;
     }
     csv.close();
@@ -318,20 +563,21 @@ class harness {
     // Plot: PSNR (capped at 60 dB for the exact methods) against seconds, one series per method.
     const std::string base = csv_path.size() > 4 && csv_path.ends_with(".csv") ? csv_path.substr(0, csv_path.size() - 4) : csv_path;
     std::ofstream dat(base + ".dat");
-    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer", "ibuffer_occl"};
+    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast",
+                             "ibuffer",     "ibuffer_linear", "ibuffer_probe",   "ibuffer_occl"};
     for (const char* m : methods) {
       dat << "# " << m << "\n";
       for (const auto& r : rows_)
-        if (r.method == m) dat << r.seconds << " " << std::min(r.psnr, 60.0) << " " << r.ssim << "\n";
+        if (r.method == m) dat << r.cpu_seconds << " " << std::min(r.psnr, 60.0) << " " << r.ssim << "\n";
       dat << "\n\n";
     }
     dat.close();
     std::ofstream gp(base + ".gp");
     gp << "set terminal pngcairo size 1000,650 noenhanced\nset output '" << base << ".png'\n"
        << "set title 'Demo scene " << w_ << "x" << h_ << ": PSNR against render time (exact methods drawn at 60 dB)'\n"
-       << "set xlabel 'seconds (log)'\nset ylabel 'PSNR dB vs full per-pixel evaluation'\nset logscale x\nset grid\n"
+       << "set xlabel 'CPU seconds, all threads (log)'\nset ylabel 'PSNR dB vs full per-pixel evaluation'\nset logscale x\nset grid\n"
        << "set key bottom right\nplot ";
-    for (int i = 0; i < 7; ++i)
+    for (int i = 0; i < 9; ++i)
       gp << (i ? ", " : "") << "'" << base << ".dat' index " << i << " using 1:2 with points pt " << (i + 4)
          << " title '" << methods[i] << "'";
     gp << "\n";
@@ -348,8 +594,12 @@ class harness {
   int w_, h_, threads_;
   sup::image reference_;
   std::vector<float> ref_luma_;
-  double t_full_ = 0;
+  double t_full_ = 0, cpu_full_ = 0;
   std::vector<row> rows_;
+
+ public:
+  std::string only_;
+  int repeat_ = 3;  // --repeat N: each method's time is the least of N runs (the machine is shared)
 };
 
 bool parse_int(const char* text, int lo, int hi, int& out) {
@@ -365,6 +615,9 @@ bool parse_int(const char* text, int lo, int hi, int& out) {
 
 int pareto_upsample(int argc, char** argv) {
   std::string csv;
+  bool diagnose = false;
+  std::string only;
+  int repeat = 3;
   int width = 1025, height = 1025, threads = 0, ao = 64, soft = 16;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
@@ -373,6 +626,12 @@ int pareto_upsample(int argc, char** argv) {
       csv = argv[++i];
     } else if (a == "--size" && has2 && parse_int(argv[i + 1], 16, 16384, width) && parse_int(argv[i + 2], 16, 16384, height)) {
       i += 2;
+    } else if (a == "--only" && has1) {
+      only = argv[++i];
+    } else if (a == "--repeat" && has1 && parse_int(argv[i + 1], 1, 100, repeat)) {
+      ++i;
+    } else if (a == "--diagnose") {
+      diagnose = true;
     } else if (a == "--threads" && has1 && parse_int(argv[i + 1], 1, 1024, threads)) {
       ++i;
     } else if (a == "--ao" && has1 && parse_int(argv[i + 1], 0, 4096, ao)) {
@@ -380,11 +639,11 @@ int pareto_upsample(int argc, char** argv) {
     } else if (a == "--soft" && has1 && parse_int(argv[i + 1], 0, 4096, soft)) {
       ++i;
     } else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample --csv FILE [--size W H] [--threads N] [--ao N] [--soft N]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--repeat N] [--size W H] [--threads N] [--ao N] [--soft N]\n");
       return 2;
     }
   }
-  if (csv.empty()) {
+  if (csv.empty() && !diagnose) {
     std::fprintf(stderr, "infolerp_pareto upsample: --csv FILE is required\n");
     return 2;
   }
@@ -401,6 +660,37 @@ int pareto_upsample(int argc, char** argv) {
   const sup::shader_options shading{.ao_rays = static_cast<unsigned>(ao), .soft_shadow_rays = static_cast<unsigned>(soft)};
   std::printf("demo scene %dx%d, AO %d rays, soft shadow %d rays, threads %d\n", width, height, ao, soft,
               threads > 0 ? threads : omp_get_max_threads());
+  const double t0 = now_seconds();
+  auto clustered = sup::cluster_by_features(*scene, infolerp::openmp_executor{threads});
+  if (!clustered) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", clustered.error().message().c_str());
+    return 1;
+  }
+  const auto features = sup::split_at_texture_seams(*scene, *clustered);
+  std::printf("feature clustering (demo thresholds): %zu clusters, %zu ids after the texture-seam split, %.1f s\n",
+              clustered->count(), features.count(), now_seconds() - t0);
+  // Coarser thresholds (fewer clusters): the paper's Fig. 8 setting (110 clusters there) and one between.
+  std::vector<sup::scene_clustering> coarser;
+  for (const sup::cluster_thresholds& th : {sup::cluster_thresholds{{"visibility", 0.54f}, {"orientation", 0.3f}, {"stretch", 0.1f}},
+                                            sup::cluster_thresholds{{"visibility", 0.54f}, {"orientation", 0.2f}, {"stretch", 0.1f}},
+                                            sup::cluster_thresholds{{"visibility", 0.48f}, {"orientation", 0.3f}, {"stretch", 0.1f}},
+                                            sup::cluster_thresholds{{"visibility", 0.6f}, {"orientation", 0.3f}, {"stretch", 0.1f}},
+                                            sup::cluster_thresholds{{"visibility", 0.48f}, {"orientation", 0.15f}, {"stretch", 0.1f}}}) {
+    if (diagnose) break;
+    auto r = sup::cluster_by_features(*scene, infolerp::openmp_executor{threads}, th);
+    if (!r) {
+      std::fprintf(stderr, "infolerp_pareto upsample: %s\n", r.error().message().c_str());
+      return 1;
+    }
+    coarser.push_back(sup::split_at_texture_seams(*scene, *r));
+    char name[96];
+    std::snprintf(name, sizeof name, "feature V%.2f O%.2f S%.2f", static_cast<double>(th.at("visibility")),
+                  static_cast<double>(th.at("orientation")), static_cast<double>(th.at("stretch")));
+    coarser.back().name = name;
+    std::printf("%s: %zu clusters, %zu ids\n", name, r->count(), coarser.back().count());
+  }
   harness h(*scene, shading, width, height, threads);
-  return h.run(csv);
+  h.only_ = only;
+  h.repeat_ = repeat;
+  return diagnose ? h.diagnose(features) : h.run(csv, features, coarser);
 }

@@ -3,7 +3,9 @@
 // visibility → orientation → stretch), with a progress bar for the visibility rays, written as
 // DIR/clusters.png (the scene from the camera, each cluster a distinct colour).
 //   bool stage_clusters(const demo_context& ctx, support::scene_clustering& out);
-// out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage.
+// out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage; the
+// clustering itself is support::cluster_by_features (tests/support/demo_clusters.hpp), which the
+// time-against-error harness uses too.
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -11,11 +13,10 @@
 #include <vector>
 #include <glm/vec3.hpp>
 #include "demo.hpp"
-#include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 #include "support/demo_upsample.hpp"
-#include "support/procedural.hpp"
+#include "support/demo_clusters.hpp"
 
 namespace infolerp::demo {
 
@@ -29,50 +30,26 @@ inline glm::vec3 cluster_colour(std::uint32_t k) {
   return glm::vec3(rgb + mn);
 }
 
-// Clusters one mesh with any tracer; returns the clustering (ids per triangle). thresholds maps
-// a channel name (visibility, orientation, stretch) to its Th; missing ones take the defaults.
-template <class Tracer, class Exec>
-result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& tracer, Exec&& exec, const std::string& label,
-                                       const std::map<std::string, float>& thresholds = {}) {
-  const auto th = [&](const char* channel, double fallback) {
-    const auto it = thresholds.find(channel);
-    return it == thresholds.end() ? fallback : static_cast<double>(it->second);
-  };
-  progress_bar bar("visibility " + label);
-  return cluster_mesh(mesh, tracer, exec, cluster_options{},
-                      visibility_channel{.threshold = th("visibility", 0.48), .viewpoints = 64,
-                                         .progress = [&](std::size_t done, std::size_t total) {
-                                           bar(static_cast<int>(done), static_cast<int>(total));
-                                         }},
-                      orientation_channel{.threshold = th("orientation", 0.05), .bins = 256},
-                      stretch_channel{.threshold = th("stretch", 0.1), .bins = 256});
-}
-
 inline bool stage_clusters(const demo_context& ctx, support::scene_clustering& out) {
-  out = {"feature", {}, {}};
-  std::uint32_t offset = 0;
-  for (std::uint32_t g = 0; g < ctx.scene.objects.size(); ++g) {
-    const auto& object = ctx.scene.objects[g];
-    std::vector<std::uint32_t> remap;
-    const indexed_mesh welded = support::weld_positions(object.mesh, remap);  // seams joined; same triangles
+  std::map<std::string, progress_bar> bars;
+  const auto progress = [&](const std::string& label, std::size_t done, std::size_t total) {
+    bars.try_emplace(label, "visibility " + label).first->second(static_cast<int>(done), static_cast<int>(total));
+  };
+  const auto on_object = [](const std::string& name, const mesh_clustering& r) {
+    std::printf("clusters %s: %u (", name.c_str(), r.cluster_count);
+    for (std::size_t i = 0; i < r.channels.size(); ++i) std::printf(i ? ", %u" : "%u", r.channels[i].clusters_after);
+    std::printf(" after each channel)%s\n", r.channels[2].skipped ? ", stretch skipped: no texcoords" : "");
+  };
 #ifdef _OPENMP
-    auto r = cluster_object(welded, ctx.scene.tracer, openmp_executor{ctx.options.threads}, object.name, ctx.options.thresholds);
+  auto r = support::cluster_by_features(ctx.scene, openmp_executor{ctx.options.threads}, ctx.options.thresholds, progress, on_object);
 #else
-    auto r = cluster_object(welded, ctx.scene.tracer, serial_executor{}, object.name, ctx.options.thresholds);
+  auto r = support::cluster_by_features(ctx.scene, serial_executor{}, ctx.options.thresholds, progress, on_object);
 #endif
-    if (!r) {
-      report(r.error());
-      return false;
-    }
-    std::printf("clusters %s: %u (", object.name.c_str(), r->cluster_count);
-    for (std::size_t i = 0; i < r->channels.size(); ++i)
-      std::printf(i ? ", %u" : "%u", r->channels[i].clusters_after);
-    std::printf(" after each channel)%s\n", r->channels[2].skipped ? ", stretch skipped: no texcoords" : "");
-    for (auto& k : r->cluster_of) k += offset;
-    offset += r->cluster_count;
-    out.ids.push_back(std::move(r->cluster_of));
-    out.geometry_of.insert(out.geometry_of.end(), r->cluster_count, g);
+  if (!r) {
+    report(r.error());
+    return false;
   }
+  out = std::move(*r);
   const auto img = render_false_colour(
       ctx, [&](std::uint32_t g, std::uint32_t t, glm::vec2) { return cluster_colour(out.ids[g][t]); });
   return save_png(ctx, img, "clusters.png");

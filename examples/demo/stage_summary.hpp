@@ -38,9 +38,9 @@ inline bool stage_summary(const demo_context& ctx) {
   const double t_ref = rows.front().seconds;
   auto speedup = [&](const method_result& r) { return r.seconds > 0.0 ? t_ref / r.seconds : 0.0; };
 
-  std::printf("\n%-13s %9s %9s %10s %7s %10s\n", "method", "time (s)", "speed-up", "PSNR (dB)", "SSIM", "evaluated");
+  std::printf("\n%-16s %9s %9s %10s %7s %10s\n", "method", "time (s)", "speed-up", "PSNR (dB)", "SSIM", "evaluated");
   for (const auto& r : rows)
-    std::printf("%-13s %9.3f %8.2fx %10.2f %7.4f %9.2f%%\n", r.method.c_str(), r.seconds, speedup(r), r.psnr, r.ssim,
+    std::printf("%-16s %9.3f %8.2fx %10.2f %7.4f %9.2f%%\n", r.method.c_str(), r.seconds, speedup(r), r.psnr, r.ssim,
                 100.0 * r.evaluated);
 
   const auto dir = ctx.options.out_dir;

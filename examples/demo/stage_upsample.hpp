@@ -2,7 +2,9 @@
 // Demo stage: the demo scene rendered with the I-Buffer upsampler (paper §4), compared with the
 // per-pixel reference of the first stage.
 //   - the trade-off runs: one frame at each of 2..5 passes (method "ibuffer-K"; one pass is
-//     plain per-pixel evaluation, i.e. the reference), each added to ctx.results;
+//     plain per-pixel evaluation, i.e. the reference), and at 3..5 passes with probes (method
+//     "ibuffer-probe-K": primary hit + sun ray per pixel, AO and soft shadow interpolated), each
+//     added to ctx.results;
 //   - the shown frame, at --passes K, or with --passes auto under the pass controller (§4.2,
 //     include/infolerp/upsample/pass_controller.hpp, default frame-time bounds 1/60..1/30 s,
 //     at most 4 passes): the reference render counts as its first, one-pass frame, then frames
@@ -17,7 +19,8 @@
 //   bool stage_upsample(demo_context& ctx, const support::scene_clustering* clusters = nullptr);
 // Preconditions: ctx.reference holds the reference render (stage 1). clusters: per-triangle
 // cluster ids of the scene (e.g. from include/infolerp/cluster); nullptr uses the stand-in
-// cluster_by_normal(scene, 2) of tests/support/demo_upsample.hpp. Returns false on error.
+// cluster_by_normal(scene, 2) of tests/support/demo_upsample.hpp. Either is cut at texture seams
+// (support::split_at_texture_seams) for the I-Buffer. Returns false on error.
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -27,6 +30,7 @@
 #include "demo.hpp"
 #include "infolerp/upsample/pass_controller.hpp"
 #include "infolerp/upsample/upsampler.hpp"
+#include "support/demo_clusters.hpp"
 #include "support/demo_upsample.hpp"
 
 namespace infolerp::demo {
@@ -54,12 +58,11 @@ inline support::image error_heat_map(const support::image& img, const support::i
 
 inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* clusters = nullptr) {
   const auto& o = ctx.options;
-  support::scene_clustering fallback;
-  if (clusters == nullptr) {
-    fallback = support::cluster_by_normal(ctx.scene, 2);
-    clusters = &fallback;
-  }
-  constexpr std::uint32_t tradeoff_first = 2, tradeoff_last = 5, auto_max_passes = 4;
+  // The I-Buffer's ids: the clusters cut at texture seams (texcoords are interpolated within an id).
+  const support::scene_clustering ids =
+      support::split_at_texture_seams(ctx.scene, clusters != nullptr ? *clusters : support::cluster_by_normal(ctx.scene, 2));
+  clusters = &ids;
+  constexpr std::uint32_t tradeoff_first = 2, tradeoff_last = 5, auto_max_passes = 4, probe_first = 3, probe_min_sources = 1;
   const auto w = static_cast<std::uint32_t>(o.width), h = static_cast<std::uint32_t>(o.height);
   auto up = upsampler<support::demo_sample>::create(
       w, h, {.passes = 1, .max_passes = std::max({o.passes, tradeoff_last, auto_max_passes})});
@@ -94,6 +97,37 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
       return false;
     }
     record("ibuffer-" + std::to_string(p), std::to_string(p) + " passes, " + cluster_note);
+  }
+
+  // The trade-off runs with probes (sample_source.hpp): primary hit + sun ray at every pixel,
+  // AO and soft shadow interpolated from the sources that match the pixel's own cluster id.
+  {
+    support::shader_options po = ctx.shader.options();
+    po.ao_rays = 0;
+    po.soft_shadow_rays = 0;
+    const support::reference_shader primary(ctx.scene, po);
+    support::demo_probe_source psrc;
+    static_cast<support::demo_ibuffer_source&>(psrc) = src;
+    psrc.primary = &primary;
+    auto pu = upsampler<support::demo_sample>::create(
+        w, h, {.passes = probe_first, .max_passes = tradeoff_last, .record_kinds = false, .min_sources = probe_min_sources});
+    if (!pu) {
+      report(pu.error());
+      return false;
+    }
+    for (std::uint32_t p = probe_first; p <= tradeoff_last; ++p) {
+      status s = pu->set_passes(p);
+      if (s) s = pu->render(psrc, std::span<glm::vec3>(img.pixels), exec);
+      if (!s) {
+        report(s);
+        return false;
+      }
+      const auto& r = add_result(ctx, "ibuffer-probe-" + std::to_string(p),
+                                 std::to_string(p) + " passes, probes (primary + sun per pixel), " + cluster_note,
+                                 pu->stats().seconds, pu->stats().evaluated_fraction(), img);
+      std::printf("%-16s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
+                  ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());
+    }
   }
 
   std::string chosen;

@@ -25,11 +25,17 @@ float hash01(int x, int y) {
 }
 }  // namespace
 
-ray camera::primary_ray(float x, float y, int width, int height) const {
-  const glm::vec3 forward = glm::normalize(target - eye);
-  const glm::vec3 right = glm::normalize(glm::cross(forward, up));
-  const glm::vec3 true_up = glm::cross(right, forward);
-  const float half_h = std::tan(0.5f * vertical_fov_degrees * pi / 180.0f);
+pinhole_rays camera::rays() const {
+  pinhole_rays r;
+  r.eye = eye;
+  r.forward = glm::normalize(target - eye);
+  r.right = glm::normalize(glm::cross(r.forward, up));
+  r.true_up = glm::cross(r.right, r.forward);
+  r.half_h = std::tan(0.5f * vertical_fov_degrees * pi / 180.0f);
+  return r;
+}
+
+ray pinhole_rays::operator()(float x, float y, int width, int height) const {
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
   const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * half_h * aspect;
   const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * half_h;
@@ -38,6 +44,8 @@ ray camera::primary_ray(float x, float y, int width, int height) const {
   r.direction = glm::normalize(forward + sx * right + sy * true_up);
   return r;
 }
+
+ray camera::primary_ray(float x, float y, int width, int height) const { return rays()(x, y, width, height); }
 
 glm::vec3 area_light::normal() const { return glm::normalize(glm::cross(edge_u, edge_v)); }
 float area_light::area() const { return glm::length(glm::cross(edge_u, edge_v)); }

@@ -17,6 +17,14 @@
 namespace infolerp::support {
 
 // A pinhole camera that looks from eye at target.
+// A pinhole camera's ray generator with its basis computed once (camera::primary_ray builds it
+// on every call, which costs as much as shading a pixel). Same rays, bit for bit.
+struct pinhole_rays {
+  glm::vec3 eye{0.0f}, forward{0.0f}, right{0.0f}, true_up{0.0f};
+  float half_h = 0.0f;
+  ray operator()(float x, float y, int width, int height) const;
+};
+
 struct camera {
   glm::vec3 eye{0.0f, -10.0f, 3.0f};
   glm::vec3 target{0.0f};
@@ -26,6 +34,8 @@ struct camera {
   // The ray through image point (x, y) of a width x height image, in pixels from the top-left
   // corner (pixel (i, j) has its centre at (i + 0.5, j + 0.5)). Unit direction, tnear 0.
   ray primary_ray(float x, float y, int width, int height) const;
+  // The basis of primary_ray, for many rays of one camera.
+  pinhole_rays rays() const;
 };
 
 // A directional light with hard shadows. direction points toward the sun (unit length).

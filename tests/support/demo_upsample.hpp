@@ -3,12 +3,14 @@
 // shared by the demo's upsampler stage and the time-against-error harness:
 //   evaluate(x, y): the reference shader's full evaluation of pixel (x, y) (primary ray, hard
 //                   shadow, soft shadow, AO) stored in the default record surface_sample<2>:
-//                   position, normal, texcoords, cluster id, sun bit, occlusion {ao, soft}.
+//                   position, normal, texcoords, cluster id, sun bit, occlusion {ao, soft},
+//                   inv_depth = 1 / view depth (perspective-correct weights; 1 without `perspective`).
 //   shade(s, x, y): the reference shader's shade() of that record; the view direction is the
 //                   pixel's primary ray and the material is the cluster's object.
 // Evaluated pixels reproduce the reference render (up to the renormalised normal's last bit).
 //
-// Clusterings: STAND-INS until the clustering of include/infolerp/cluster/ lands in main:
+// Clusterings: the real feature clustering is support::cluster_by_features (demo_clusters.hpp);
+// two simple stand-ins for comparison:
 //   cluster_by_object   one cluster per scene object (geometry id)
 //   cluster_by_normal   per object, face normals binned on a cube map (cells×cells per face),
 //                       split further at texcoord halves so that no cluster spans a UV seam.
@@ -82,6 +84,7 @@ struct demo_ibuffer_source {
   const scene_clustering* clusters = nullptr;
   int width = 0;
   int height = 0;
+  bool perspective = true;  // inv_depth = 1 / view depth (perspective-correct weights); false: 1 (screen-linear)
 
   demo_sample evaluate(std::uint32_t x, std::uint32_t y) const {
     std::uint64_t rays = 0;
@@ -98,12 +101,15 @@ struct demo_ibuffer_source {
     s.cluster = clusters->ids[in.geometry][in.triangle];
     s.lights = in.light_bits;
     s.occlusion = {in.ao, in.soft_shadow};
+    if (perspective) {
+      const pinhole_rays& view = shader->camera_rays();
+      s.inv_depth = 1.0f / std::max(glm::dot(in.position - view.eye, view.forward), 1e-6f);
+    }
     return s;
   }
   shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
     shading_inputs in;
-    in.view = glm::normalize(
-        shader->scene().view.primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
+    in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
     if (s.background()) return in;
     in.position = s.position;
     const float len = glm::length(s.normal);
@@ -116,6 +122,36 @@ struct demo_ibuffer_source {
     return in;
   }
   glm::vec3 shade(const demo_sample& s, std::uint32_t x, std::uint32_t y) const { return shader->shade(to_inputs(s, x, y)); }
+};
+
+// The same with probes (sample_source.hpp): the cheap part of every pixel, its primary hit
+// (cluster id, position, normal, texcoords) and, with probe_lights, the sun's hard-shadow ray,
+// comes from `primary`: a reference shader without AO and soft-shadow rays
+// (shader_options{.ao_rays = 0, .soft_shadow_rays = 0, .hard_shadow = probe_lights}). AO and
+// soft shadow (80 of a full evaluation's 82 rays), and without probe_lights the sun bit too, are
+// interpolated; then the sources must agree on the sun bit, as in the plain I-Buffer.
+struct demo_probe_source : demo_ibuffer_source {
+  const reference_shader* primary = nullptr;
+  bool probe_lights = true;
+
+  demo_sample probe(std::uint32_t x, std::uint32_t y) const {
+    std::uint64_t rays = 0;
+    return from_inputs(primary->evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height, rays));
+  }
+  bool probe_compatible(const demo_sample& p, const demo_sample& s) const {
+    return probe_lights ? compatible(p, s) : p.cluster == s.cluster;
+  }
+  demo_sample interpolate(const demo_sample& p, const demo_sample& a, const demo_sample& b) const {
+    demo_sample s = infolerp::interpolate(p, a, b);
+    if (!probe_lights) s.lights = a.lights;
+    return s;
+  }
+  demo_sample interpolate(const demo_sample& p, const demo_sample& a, const demo_sample& b, const demo_sample& c,
+                          const demo_sample& d) const {
+    demo_sample s = infolerp::interpolate(p, a, b, c, d);
+    if (!probe_lights) s.lights = a.lights;
+    return s;
+  }
 };
 
 // Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.

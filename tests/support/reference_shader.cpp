@@ -46,7 +46,7 @@ void tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
 }  // namespace
 
 reference_shader::reference_shader(const demo_scene& scene, const shader_options& options)
-    : scene_(&scene), options_(options) {
+    : scene_(&scene), options_(options), rays_(scene.view.rays()) {
   // Cosine-weighted hemisphere directions (Malley's method on Hammersley points).
   for (unsigned i = 0; i < options_.ao_rays; ++i) {
     const glm::vec2 s = hammersley(i, options_.ao_rays);
@@ -75,7 +75,7 @@ unsigned reference_shader::count_unoccluded(std::span<const ray> rays) const {
 }
 
 shading_inputs reference_shader::evaluate_pixel(float x, float y, int width, int height, std::uint64_t& rays) const {
-  return evaluate(scene_->view.primary_ray(x, y, width, height), rays);
+  return evaluate(rays_(x, y, width, height), rays);
 }
 
 shading_inputs reference_shader::evaluate(const ray& primary, std::uint64_t& rays) const {
@@ -122,7 +122,7 @@ shading_inputs reference_shader::evaluate_hit(const ray& primary, const hit& h, 
   };
 
   // Hard shadow: one ray toward the sun (none when the surface faces away).
-  if (glm::dot(ng, scene.sun.direction) > 0.0f) {
+  if (options_.hard_shadow && glm::dot(ng, scene.sun.direction) > 0.0f) {
     batch[count++] = ray{origin, 0.0f, scene.sun.direction};
     if (flush() == 1) in.light_bits |= sun_light_bit;
   }

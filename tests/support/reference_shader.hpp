@@ -27,6 +27,7 @@ struct shader_options {
   unsigned ao_rays = 64;           // N: ambient-occlusion rays per pixel (0 = no AO, ao = 1)
   unsigned soft_shadow_rays = 16;  // M: rays to fixed points on the area light (0 = light off)
   bool packets = false;            // trace a pixel's AO and soft-shadow rays as 16-ray packets
+  bool hard_shadow = true;         // trace the sun's hard-shadow ray (false: light_bits stay 0)
 };
 
 // What evaluate() finds at a pixel: everything shade() needs. Interpolating records (not
@@ -48,7 +49,8 @@ inline constexpr std::uint32_t sun_light_bit = 1u;
 
 class reference_shader {
  public:
-  // Precomputes the fixed direction and light-point sets. The scene must outlive the shader.
+  // Precomputes the fixed direction and light-point sets and the camera basis. The scene must
+  // outlive the shader; its camera is read here.
   reference_shader(const demo_scene& scene, const shader_options& options = {});
 
   // Full evaluation of the pixel point (x, y) (pixel centres at +0.5) of a width x height image.
@@ -62,6 +64,11 @@ class reference_shader {
   // Linear RGB of a record (pure; no rays). Thread-safe.
   glm::vec3 shade(const shading_inputs& in) const;
 
+  // The primary ray of pixel point (x, y): scene().view.primary_ray with the camera basis
+  // computed once, at construction (the shader reads the camera then).
+  ray primary_ray(float x, float y, int width, int height) const { return rays_(x, y, width, height); }
+  const pinhole_rays& camera_rays() const { return rays_; }
+
   const demo_scene& scene() const { return *scene_; }
   const shader_options& options() const { return options_; }
   // The most rays one evaluate() can trace: 1 + 1 + M + N.
@@ -73,6 +80,7 @@ class reference_shader {
 
   const demo_scene* scene_;
   shader_options options_;
+  pinhole_rays rays_;
   std::vector<glm::vec3> hemisphere_;    // N cosine-weighted directions around +Z
   std::vector<glm::vec3> light_points_;  // M points on the area light
 };

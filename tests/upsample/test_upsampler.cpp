@@ -3,6 +3,7 @@
 // R/I/E pattern of Fig. 7, boundaries, any output size, every pixel written, determinism.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -11,6 +12,7 @@
 #include <new>
 #include <string>
 #include <vector>
+#include <glm/geometric.hpp>
 #include <glm/vec4.hpp>
 #include "infolerp/upsample/upsampler.hpp"
 #include "support/thread_pool.hpp"
@@ -156,6 +158,68 @@ struct careless {
   }
   float shade(const bg_sample& s, std::uint32_t, std::uint32_t) const { return s.miss ? -1.0f : s.value; }
 };
+
+// Any source with probes: the probe is the full evaluation with the expensive terms poisoned
+// (NaN), so a probe that reaches the output without its occlusion completed shows up.
+template <class Inner>
+struct probing {
+  using sample_type = sample;
+  Inner inner;
+  mutable std::atomic<std::uint32_t> evaluations{0};
+  sample evaluate(std::uint32_t x, std::uint32_t y) const {
+    evaluations.fetch_add(1, std::memory_order_relaxed);
+    return inner.evaluate(x, y);
+  }
+  sample probe(std::uint32_t x, std::uint32_t y) const {
+    sample s = inner.evaluate(x, y);
+    s.occlusion = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN()};
+    return s;
+  }
+  auto shade(const sample& s, std::uint32_t x, std::uint32_t y) const { return inner.shade(s, x, y); }
+};
+
+// Cluster 0 everywhere but a one-pixel column of cluster 1 at x = 5, between the even columns
+// the last pass's sources sit on: the sources agree, the pixel itself does not.
+struct thin_line {
+  using sample_type = sample;
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    sample s;
+    s.cluster = xi == 5 ? 1u : 0u;
+    s.lights = 1;
+    s.texcoord = {static_cast<float>(xi), static_cast<float>(yi)};
+    s.occlusion = {xi == 5 ? 0.0f : 1.0f, 0.5f};
+    return s;
+  }
+  float shade(const sample& s, std::uint32_t, std::uint32_t) const { return s.occlusion[0]; }
+};
+
+// Pinhole camera at the origin looking along +z (focal length 64 px), a tilted plane n·p = 4;
+// texcoords and AO affine in world space, hence not linear in screen space.
+struct plane_view {
+  using sample_type = sample;
+  bool weights = true;
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    const glm::vec3 d{(static_cast<float>(xi) - 40.0f) / 64.0f, (static_cast<float>(yi) - 30.0f) / 64.0f, 1.0f};
+    const glm::vec3 n{0.0f, 0.8f, 0.6f};
+    const float t = 4.0f / glm::dot(n, d);
+    const glm::vec3 p = t * d;
+    sample s;
+    s.cluster = 0;
+    s.lights = 1;
+    s.position = p;
+    s.normal = n;
+    s.texcoord = {0.25f * p.x + 1.0f, 0.5f * p.y - 0.125f * p.z};
+    s.occlusion = {0.5f + 0.01f * p.x, 0.3f + 0.02f * p.z};
+    s.inv_depth = weights ? 1.0f / p.z : 1.0f;
+    return s;
+  }
+  float shade(const sample& s, std::uint32_t, std::uint32_t) const { return s.texcoord.x; }
+};
+
+bool same_primary(const sample& a, const sample& b) {
+  return a.position == b.position && a.normal == b.normal && a.texcoord == b.texcoord && a.cluster == b.cluster &&
+         a.lights == b.lights;
+}
 
 }  // namespace
 
@@ -383,4 +447,122 @@ TEST_CASE("bad input gives a clear status", "[upsample]") {
   CHECK(infolerp::upsample(src, 2, 2, std::span<glm::vec4>(out), infolerp::serial_executor{}).ok());
   CHECK(infolerp::upsample(src, 0, 2, std::span<glm::vec4>(out), infolerp::serial_executor{}).code() ==
         infolerp::errc::empty_input);
+}
+
+TEST_CASE("with probes, each new sample is tested with its own cluster id", "[upsample]") {
+  static_assert(infolerp::probing_sample_source<probing<thin_line>>);
+  static_assert(!infolerp::probing_sample_source<thin_line>);
+  const std::uint32_t w = 17, h = 9;
+  // Without probes the column's sources (x = 4 and 6, cluster 0) agree: it is interpolated over.
+  auto plain = make(w, h, 2);
+  std::vector<float> out(static_cast<std::size_t>(w) * h);
+  thin_line line;
+  REQUIRE(plain.render(line, std::span<float>(out)).ok());
+  CHECK(plain.ibuffer()[5].cluster == 0u);
+  CHECK(out[5] == 1.0f);
+  // With probes it is evaluated, row by row.
+  probing<thin_line> src;
+  auto up = make(w, h, 2);
+  REQUIRE(up.render(src, std::span<float>(out)).ok());
+  for (std::uint32_t y = 0; y < h; ++y) {
+    INFO("row " << y);
+    CHECK(up.ibuffer()[y * w + 5].cluster == 1u);
+    CHECK(out[y * w + 5] == 0.0f);
+    CHECK(up.kinds()[y * w + 5] == sample_kind::evaluated);
+  }
+}
+
+TEST_CASE("with probes: the cheap part is exact everywhere, the expensive part exact on one cluster", "[upsample]") {
+  for (bool edges : {false, true}) {
+    INFO("cluster and shadow edges " << edges);
+    probing<region_source> src;
+    src.inner.cluster_edge = edges;
+    src.inner.shadow_edge = edges;
+    src.inner.background_edge = edges;
+    const std::uint32_t w = 150, h = 333;
+    for (std::uint32_t min_sources : {1u, 2u})
+      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+        INFO("passes " << passes << " min_sources " << min_sources);
+        auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
+                                                            .min_sources = min_sources});
+        REQUIRE(u.ok());
+        auto out = poisoned<region_source>(w, h);
+        REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+        const auto ib = u->ibuffer();
+        std::size_t wrong_primary = 0, wrong = 0, unset = 0;
+        for (std::uint32_t y = 0; y < h; ++y)
+          for (std::uint32_t x = 0; x < w; ++x) {
+            const sample& s = ib[y * w + x];
+            const sample e = src.inner.evaluate(x, y);
+            wrong_primary += same_primary(s, e) ? 0 : 1;
+            wrong += same_bits(s, e) ? 0 : 1;
+            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
+          }
+        CHECK(wrong_primary == 0);
+        CHECK(unset == 0);
+        if (!edges) {
+          CHECK(wrong == 0);
+          CHECK(u->stats().evaluated() == u->stats().pass[0].evaluated);
+        }
+        // Fewer evaluations than the plain I-Buffer: a boundary sample is completed from the
+        // sources on its own side instead of being evaluated.
+        auto plain = make(w, h, passes);
+        REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out)).ok());
+        if (edges) CHECK(u->stats().evaluated() < plain.stats().evaluated());
+        if (!edges) CHECK(u->stats().evaluated() == plain.stats().evaluated());
+      }
+  }
+}
+
+TEST_CASE("with probes, serial and parallel outputs are bit-identical", "[upsample]") {
+  probing<wavy> src;
+  const std::uint32_t w = 257, h = 190;
+  for (std::uint32_t min_sources : {1u, 2u}) {
+    auto make_probe = [&] {
+      auto u = infolerp::upsampler<sample>::create(w, h, {.passes = 4, .max_passes = 4, .min_sources = min_sources});
+      REQUIRE(u.ok());
+      return std::move(*u);
+    };
+    auto serial = make_probe();
+    std::vector<glm::vec4> ref(static_cast<std::size_t>(w) * h);
+    REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
+    CHECK(serial.stats().evaluated() > serial.stats().pass[0].evaluated);
+    for (unsigned threads : {2u, 8u}) {
+      auto up = make_probe();
+      std::vector<glm::vec4> out(ref.size(), glm::vec4(-7.0f));
+      REQUIRE(up.render(src, std::span<glm::vec4>(out), infolerp::support::thread_pool_executor{threads}).ok());
+      CHECK(std::memcmp(out.data(), ref.data(), out.size() * sizeof(glm::vec4)) == 0);
+      CHECK(std::equal(up.kinds().begin(), up.kinds().end(), serial.kinds().begin()));
+    }
+    // No allocation per frame with probes either.
+    const std::size_t before = g_allocations.load();
+    REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
+    CHECK(g_allocations.load() == before);
+  }
+  auto bad = infolerp::upsampler<sample>::create(8, 8, {.min_sources = 3});
+  REQUIRE_FALSE(bad.ok());
+  CHECK(bad.error().code() == infolerp::errc::bad_parameter);
+  CHECK(bad.error().message().find("min_sources 3") != std::string::npos);
+}
+
+TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in perspective", "[upsample]") {
+  auto max_error = [](const plane_view& src) {
+    auto up = make(81, 61, 4);
+    std::vector<float> out(81 * 61);
+    REQUIRE(up.render(src, std::span<float>(out)).ok());
+    float e = 0.0f;
+    for (std::uint32_t y = 0; y < 61; ++y)
+      for (std::uint32_t x = 0; x < 81; ++x) {
+        const sample& s = up.ibuffer()[y * 81 + x];
+        const sample r = src.evaluate(x, y);
+        e = std::max({e, glm::length(s.texcoord - r.texcoord), glm::length(s.position - r.position),
+                      std::abs(s.occlusion[0] - r.occlusion[0]), std::abs(s.occlusion[1] - r.occlusion[1])});
+      }
+    return e;
+  };
+  plane_view perspective, linear;
+  linear.weights = false;
+  const float e_perspective = max_error(perspective), e_linear = max_error(linear);
+  CHECK(e_perspective < 1e-4f);
+  CHECK(e_linear > 1e-2f);
 }
