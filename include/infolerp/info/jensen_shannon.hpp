@@ -173,6 +173,51 @@ double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p 
 #endif
   return js_kernel_on<js_vd, js_vu, Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 }
+
+// Σ_i p_i log₂(p_i/q_i) over the bins with p_i > 0, q_i > 0 and p_i != q_i (the others
+// contribute exactly 0), clamped at 0; each term as p·log2_accurate(p/q), summed like
+// js_kernel_on (4 accumulators, bit-identical for every vector width). Used for I(x;Y).
+template <class D, class U, class T>
+INFOLERP_JS_INLINE double kl_kernel_on(const T* p, const double* q, std::size_t n) noexcept {
+  constexpr std::size_t lanes = sizeof(D) / sizeof(double), accumulators = 4 / lanes;
+  D acc[accumulators] = {};
+  D a, b, one, ln;
+  const double ones[4] = {1.0, 1.0, 1.0, 1.0};
+  js_load<false>(one, ones, lanes, 1.0, 1.0);
+  log2_split<D> x;
+  for (std::size_t i = 0, v = 0; i < n; i += lanes, ++v) {  // tail zero-padded: p = 0 adds 0
+    js_load<false>(a, p + i, n - i, 1.0, 1.0);
+    js_load<false>(b, q + i, n - i, 1.0, 1.0);
+#if INFOLERP_JS_VECTOR
+    const U keep = INFOLERP_BIT_CAST(U, (a > 0.0) & (b > 0.0) & (a != b));
+#else
+    const U keep = std::uint64_t{0} - static_cast<std::uint64_t>(a > 0.0 && b > 0.0 && a != b);
+#endif
+    // p/q where kept, else 1 (log 0): no Inf or NaN reaches the logarithm.
+    const D r = INFOLERP_BIT_CAST(D, (INFOLERP_BIT_CAST(U, a / b) & keep) | (INFOLERP_BIT_CAST(U, one) & ~keep));
+    log2_reduce<D, U>(x, r);
+    log_atanh_series(ln, (x.f - 1.0) / (x.f + 1.0));
+    acc[v % accumulators] += INFOLERP_BIT_CAST(D, INFOLERP_BIT_CAST(U, a) & keep) * (x.k + ln * log2_e);
+  }
+  double lane[4];
+  static_assert(sizeof acc == sizeof lane);
+  std::memcpy(lane, acc, sizeof lane);
+  const double sum = (lane[0] + lane[1]) + (lane[2] + lane[3]);
+  return sum > 0.0 ? sum : 0.0;
+}
+#ifdef INFOLERP_JS_AVX2
+template <class T>
+__attribute__((target("avx2"))) double kl_kernel_avx2(const T* p, const double* q, std::size_t n) noexcept {
+  return kl_kernel_on<js_v4d, js_v4u>(p, q, n);
+}
+#endif
+template <class T>
+double kl_kernel(const T* p, const double* q, std::size_t n) noexcept {
+#ifdef INFOLERP_JS_AVX2
+  if (js_cpu_has_avx2()) return kl_kernel_avx2(p, q, n);
+#endif
+  return kl_kernel_on<js_vd, js_vu>(p, q, n);
+}
 #if INFOLERP_JS_VECTOR
 #pragma GCC diagnostic pop
 #endif
