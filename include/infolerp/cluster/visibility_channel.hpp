@@ -126,9 +126,7 @@ class visibility_state {
   }
   double mutual_information(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
-    const auto r = row(t);
-    std::vector<double> d(r.begin(), r.end());
-    return element_mutual_information(d, output_);
+    return element_mutual_information(row(t), output_);
   }
 
  private:
@@ -163,9 +161,14 @@ struct prepared_visibility_channel {
     const std::size_t nt = neighbour_offsets.empty() ? 0 : neighbour_offsets.size() - 1;
     for (std::uint32_t t : triangles)
       if (t >= nt) return make_error(errc::index_out_of_range, t, "visibility channel: triangle ", t, " out of range");
+    // OR takes samples + 1 values: tabled (the same bits as occlusion_ratio, no division per entry).
+    std::vector<double> ratio(std::size_t{samples} + 1);
+    for (std::uint32_t c = 0; c <= samples; ++c) ratio[c] = static_cast<double>(c) / static_cast<double>(samples);
     std::vector<double> weight(n, 0.0);  // Σ_t OR(t, v)
-    for (std::uint32_t t : triangles)
-      for (std::size_t v = 0; v < n; ++v) weight[v] += occlusion_ratio(t, v);
+    for (std::uint32_t t : triangles) {
+      const std::uint8_t* vis = visible.data() + std::size_t{t} * n;
+      for (std::size_t v = 0; v < n; ++v) weight[v] += ratio[vis[v]];
+    }
     std::size_t active = 0;
     for (double w : weight) active += w > 0.0 ? 1 : 0;
     visibility_state s;
@@ -179,11 +182,16 @@ struct prepared_visibility_channel {
     }
     const double pv = 1.0 / static_cast<double>(active);
     for (std::size_t v = 0; v < n; ++v) s.output_[v] = weight[v] > 0.0 ? pv : 0.0;
+    // p(t|v) = OR(t,v) / weight[v] also takes few values: tabled per (visible count, v).
+    std::vector<double> ptv_of((std::size_t{samples} + 1) * n);
+    for (std::uint32_t c = 0; c <= samples; ++c)
+      for (std::size_t v = 0; v < n; ++v) ptv_of[c * n + v] = weight[v] > 0.0 ? ratio[c] / weight[v] : 0.0;
     std::vector<double> ptv(n);
     for (std::size_t i = 0; i < m; ++i) {
+      const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
       double pt = 0.0;
       for (std::size_t v = 0; v < n; ++v) {
-        ptv[v] = weight[v] > 0.0 ? occlusion_ratio(triangles[i], v) / weight[v] : 0.0;
+        ptv[v] = ptv_of[vis[v] * n + v];
         pt += pv * ptv[v];
       }
       s.p_[i] = pt;
@@ -201,12 +209,34 @@ struct prepared_visibility_channel {
 
  private:
   // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th}.
+  // Each edge's JS is evaluated once, as divergence(lower local id, higher), and used both ways.
   void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local(m);  // (global, local), sorted
     for (std::size_t i = 0; i < m; ++i) local[i] = {triangles[i], static_cast<std::uint32_t>(i)};
     std::sort(local.begin(), local.end());
-    std::vector<float> out(s.rows_);
+    // Seen neighbours in the set (local ids, CSR) and whether each is similar.
+    std::vector<std::uint32_t> offsets(m + 1, 0), nb;
+    nb.reserve(3 * m);
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::uint32_t g = triangles[i];
+      if (!s.unseen(static_cast<std::uint32_t>(i)))
+        for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
+          const auto it = std::lower_bound(local.begin(), local.end(), std::pair{neighbours[k], 0u});
+          if (it != local.end() && it->first == neighbours[k] && !s.unseen(it->second)) nb.push_back(it->second);
+        }
+      offsets[i + 1] = static_cast<std::uint32_t>(nb.size());
+    }
+    std::vector<std::uint8_t> similar(nb.size());
+    for (std::uint32_t i = 0; i < m; ++i)
+      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        const std::uint32_t j = nb[k];
+        const std::uint32_t* first = nb.data() + offsets[j];
+        const std::uint32_t* last = nb.data() + offsets[j + 1];
+        const std::uint32_t* at = j < i ? std::find(first, last, i) : last;  // j's side, done already
+        similar[k] = at != last ? similar[static_cast<std::size_t>(at - nb.data())] : s.divergence(i, j) <= threshold;
+      }
+    std::vector<float> out(m * n, 0.0f);  // unseen rows stay 0
     std::vector<double> acc(n);
     for (std::size_t i = 0; i < m; ++i) {
       if (s.unseen(static_cast<std::uint32_t>(i))) continue;
@@ -217,14 +247,8 @@ struct prepared_visibility_channel {
         ++count;
       };
       add(i);
-      const std::uint32_t g = triangles[i];
-      for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
-        const auto it = std::lower_bound(local.begin(), local.end(), std::pair{neighbours[k], 0u});
-        if (it == local.end() || it->first != neighbours[k]) continue;
-        const std::uint32_t j = it->second;
-        if (s.unseen(j)) continue;
-        if (s.divergence(static_cast<std::uint32_t>(i), j) <= threshold) add(j);
-      }
+      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k)
+        if (similar[k]) add(nb[k]);
       for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
     }
     s.rows_ = std::move(out);
