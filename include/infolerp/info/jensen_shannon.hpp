@@ -99,9 +99,17 @@ template <bool Scaled, class D, class T>
 INFOLERP_JS_INLINE void js_load(D& v, const T* x, std::size_t count, double pre, double inv) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double);
 #if INFOLERP_JS_VECTOR
-  v = D{};
-  if (std::is_same_v<T, double> && count >= lanes) std::memcpy(&v, x, sizeof v);
-  else for (std::size_t j = 0; j < lanes && j < count; ++j) v[j] = static_cast<double>(x[j]);
+  if (count < lanes) {
+    v = D{};
+    for (std::size_t j = 0; j < count; ++j) v[j] = static_cast<double>(x[j]);
+  } else if constexpr (std::is_same_v<T, double>) {
+    std::memcpy(&v, x, sizeof v);
+  } else {  // floats: one load, one conversion
+    typedef float F __attribute__((vector_size(sizeof(D) / 2)));
+    F f;
+    std::memcpy(&f, x, sizeof f);
+    v = __builtin_convertvector(f, D);
+  }
 #else
   static_assert(lanes == 1);
   v = count ? static_cast<double>(*x) : 0.0;
