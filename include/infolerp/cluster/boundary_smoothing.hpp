@@ -55,7 +55,7 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
 // Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
 // plus O(band · log band); divergences only for the boundary and band triangles.
-// Allocation O(M).
+// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call).
 template <class S, class M>
 std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
                                 double threshold, region_growing_result& r) {

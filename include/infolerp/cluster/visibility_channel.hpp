@@ -15,7 +15,8 @@
 // class: JS between two of them is 0, between one of them and a seen triangle 1, and their
 // I(t;V) is +inf so they are never the first seed.
 // Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
-// its edge neighbours in the set with JS <= Th.
+// its edge neighbours in the set with JS <= Th (one test per edge; most are decided by an upper
+// bound on JS without logarithms, see visibility_state::within).
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
@@ -179,8 +180,8 @@ struct prepared_visibility_channel {
   }
 
   // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
-  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising,
-  // + O(M log M) to find neighbours in the set). Allocation O(M·N) floats.
+  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, one JS or
+  // bound per edge, + O(M log M) to find neighbours in the set). Allocation O(M·N) floats.
   result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
