@@ -40,6 +40,8 @@ namespace infolerp {
 // Optional, used when present:
 //   divergences(a, first, out) -> out[i] = divergence(a, first + i), a batch that may share work
 //   all_alike() -> bool: every row is identical (the clustering then skips all work)
+//   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th (false
+//       may mean either); growth then needs the exact JS only where two seeds claim an element
 // Thread-safety: const members are called concurrently from the executor's threads.
 template <class S>
 concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {

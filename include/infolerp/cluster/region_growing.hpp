@@ -12,7 +12,8 @@
 //                to the seeds so far among those with JS > Th to every seed; stop when none.
 //                Lazy: a seed's JS is evaluated (in parallel) only for the classes still
 //                candidates, and during growth only where its frontier arrives, once per
-//                (seed, class).
+//                (seed, class); with the state's surely_within, growth evaluates it exactly
+//                only where two seeds claim an element in the same ring. Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
@@ -83,19 +84,30 @@ struct region_growing_result {
 
 namespace detail {
 
-// A JS column entry not evaluated (yet): JS is never negative.
+// JS column entries that are not a value (JS is never negative): not evaluated (yet), and
+// "JS <= Th − 1e-9 by the state's surely_within, value not evaluated".
 inline constexpr float js_unknown = -1.0f;
+inline constexpr float js_bounded = -3.0f;
+
+template <class S>
+concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
+  { s.surely_within(a, a, th) } -> std::convertible_to<bool>;
+};
 
 // col[c] = JS(a, c) for the classes c listed in `which` (ascending, distinct), in parallel chunks
-// (each slot independent). Runs of consecutive classes go through the state's batch
+// (each slot independent). With a threshold (>= 0), js_bounded where the state's
+// surely_within(a, c, threshold) holds. Runs of consecutive classes go through the state's batch
 // divergences() when it has one.
 template <class S, class E>
 void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, std::span<float> col, std::size_t grain,
-                E& exec) {
+                E& exec, double threshold = -1.0) {
   for_each_chunk(exec, which.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e;) {
       const std::uint32_t c = which[i];
-      if constexpr (requires { s.divergences(a, c, col.subspan(c, 1)); }) {
+      if constexpr (has_surely_within<S>) {
+        col[c] = threshold >= 0.0 && s.surely_within(a, c, threshold) ? js_bounded : static_cast<float>(s.divergence(a, c));
+        ++i;
+      } else if constexpr (requires { s.divergences(a, c, col.subspan(c, 1)); }) {
         std::size_t j = i + 1;
         while (j < e && which[j] == which[j - 1] + 1) ++j;
         s.divergences(a, c, col.subspan(c, j - i));
@@ -247,16 +259,28 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
             missing[k].push_back(cls[n]);
           }
       std::sort(missing[k].begin(), missing[k].end());
-      detail::js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), o.grain, exec);
+      detail::js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), o.grain, exec, th);
     }
+    // A js_bounded entry is similar; its value is needed only when a second seed claims the
+    // same element in this ring (then both values are made exact, in this fixed order).
+    auto exact = [&](std::uint32_t k, std::uint32_t c) {
+      float& js = columns[k][c];
+      if (js == detail::js_bounded) js = static_cast<float>(s.divergence(seed_classes[k], c));
+      return js;
+    };
     for (std::uint32_t k = 0; k < k0; ++k)
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f)) {
           if (label[n] != invalid_id) continue;
-          const float js = columns[k][cls[n]];
-          if (!is_similar(js, th)) continue;
-          if (best_k[n] == invalid_id) touched.push_back(n);
-          if (js < best_js[n] || (js == best_js[n] && k < best_k[n])) {
+          float js = columns[k][cls[n]];
+          if (js != detail::js_bounded && !is_similar(js, th)) continue;
+          if (best_k[n] == invalid_id) {
+            touched.push_back(n);
+          } else if (best_k[n] != k) {
+            js = exact(k, cls[n]);
+            best_js[n] = exact(best_k[n], cls[n]);
+          }
+          if (best_k[n] == invalid_id || js < best_js[n] || (js == best_js[n] && k < best_k[n])) {
             best_js[n] = js;
             best_k[n] = k;
           }

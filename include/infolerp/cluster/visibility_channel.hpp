@@ -125,31 +125,33 @@ class visibility_state {
     if (ua || ub) return ua == ub ? 0.0 : 1.0;
     return js_channel(row(a), row(b), p_[a], p_[b]);
   }
-  // divergence(a, b) <= threshold, without logarithms where an upper bound decides it:
-  //   JS_π(P,Q) <= π·log₂(1/π)·Σ_{p>q}(p − q) + (1 − π)·log₂(1/(1 − π))·Σ_{q>p}(q − p),
-  // since the per-bin term f(p,q) is convex and 1-homogeneous, so for p >= q
-  // f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·π·log₂(1/π) (and symmetrically). The bound must be
-  // 1e-9 below the threshold (the kernel is accurate to ~1e-15), so the answer is always the
-  // one divergence() gives.
+  // True only if divergence(a, b) <= threshold, decided without logarithms by the upper bound
+  //   JS_π(P,Q) <= π·log₂(1/π)·Σ_{p>q}(p − q) + (1 − π)·log₂(1/(1 − π))·Σ_{q>p}(q − p)
+  // (the per-bin term f(p,q) is convex and 1-homogeneous, so for p >= q
+  // f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·π·log₂(1/π), and symmetrically). The bound must be
+  // 1e-9 below the threshold (the kernel is accurate to ~1e-15), so a true answer always agrees
+  // with divergence(); false means "not decided". O(N), no allocation.
+  bool surely_within(std::uint32_t a, std::uint32_t b, double threshold) const {
+    if (a == b || unseen(a) || unseen(b)) return false;
+    const double w = p_[a] / (p_[a] + p_[b]);  // as js_channel (both > 0 here)
+    const auto ra = row(a), rb = row(b);
+    double up[4] = {}, down[4] = {};  // 4 independent sums, unrolled so they stay in registers
+    auto step = [&](std::size_t v, std::size_t lane) {
+      const double d = static_cast<double>(ra[v]) - static_cast<double>(rb[v]);
+      up[lane] += std::max(d, 0.0);
+      down[lane] += std::max(-d, 0.0);
+    };
+    std::size_t v = 0;
+    for (; v + 4 <= n_; v += 4) step(v, 0), step(v + 1, 1), step(v + 2, 2), step(v + 3, 3);
+    for (; v < n_; ++v) step(v, 0);
+    const double total_up = (up[0] + up[1]) + (up[2] + up[3]);
+    const double total_down = (down[0] + down[1]) + (down[2] + down[3]);
+    const auto h = [](double x) { return x > 0.0 ? -x * std::log2(x) : 0.0; };
+    return h(w) * total_up + h(1.0 - w) * total_down <= threshold - 1e-9;
+  }
+  // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
-    if (a != b && !unseen(a) && !unseen(b)) {
-      const double w = p_[a] / (p_[a] + p_[b]);  // as js_channel (both > 0 here)
-      const auto ra = row(a), rb = row(b);
-      double up[4] = {}, down[4] = {};  // 4 independent sums, unrolled so they stay in registers
-      auto step = [&](std::size_t v, std::size_t lane) {
-        const double d = static_cast<double>(ra[v]) - static_cast<double>(rb[v]);
-        up[lane] += std::max(d, 0.0);
-        down[lane] += std::max(-d, 0.0);
-      };
-      std::size_t v = 0;
-      for (; v + 4 <= n_; v += 4) step(v, 0), step(v + 1, 1), step(v + 2, 2), step(v + 3, 3);
-      for (; v < n_; ++v) step(v, 0);
-      const double total_up = (up[0] + up[1]) + (up[2] + up[3]);
-      const double total_down = (down[0] + down[1]) + (down[2] + down[3]);
-      const auto h = [](double x) { return x > 0.0 ? -x * std::log2(x) : 0.0; };
-      if (h(w) * total_up + h(1.0 - w) * total_down <= threshold - 1e-9) return true;
-    }
-    return divergence(a, b) <= threshold;
+    return surely_within(a, b, threshold) || divergence(a, b) <= threshold;
   }
   double mutual_information(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
