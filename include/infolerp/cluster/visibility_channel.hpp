@@ -15,8 +15,8 @@
 // class: JS between two of them is 0, between one of them and a seen triangle 1, and their
 // I(t;V) is +inf so they are never the first seed.
 // Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
-// its edge neighbours in the set with JS <= Th (one test per edge; most are decided by an upper
-// bound on JS without logarithms, see visibility_state::within).
+// its edge neighbours in the set with JS <= Th (most tests are decided by an upper bound on JS
+// without logarithms, see visibility_state::surely_within).
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
@@ -182,8 +182,9 @@ struct prepared_visibility_channel {
   }
 
   // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
-  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, one JS or
-  // bound per edge, + O(M log M) to find neighbours in the set). Allocation O(M·N) floats.
+  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, + O(M log M)
+  // to find neighbours in the set when it is under 1/8 of the mesh). Allocation O(M·N) floats
+  // (+ T ids for a set of at least 1/8 of the mesh).
   result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
@@ -238,37 +239,30 @@ struct prepared_visibility_channel {
 
  private:
   // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th}.
-  // Each edge's JS is evaluated once, as divergence(lower local id, higher), and used both ways.
+  // The tests go through visibility_state::within, which its bound mostly decides without JS.
   void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s) const {
-    const std::size_t m = triangles.size(), n = viewpoints;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> local(m);  // (global, local), sorted
-    for (std::size_t i = 0; i < m; ++i) local[i] = {triangles[i], static_cast<std::uint32_t>(i)};
-    std::sort(local.begin(), local.end());
-    // Seen neighbours in the set (local ids, CSR) and whether each is similar.
-    std::vector<std::uint32_t> offsets(m + 1, 0), nb;
-    nb.reserve(3 * m);
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t g = triangles[i];
-      if (!s.unseen(static_cast<std::uint32_t>(i)))
-        for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
-          const auto it = std::lower_bound(local.begin(), local.end(), std::pair{neighbours[k], 0u});
-          if (it != local.end() && it->first == neighbours[k] && !s.unseen(it->second)) nb.push_back(it->second);
-        }
-      offsets[i + 1] = static_cast<std::uint32_t>(nb.size());
+    const std::size_t m = triangles.size(), n = viewpoints, nt = neighbour_offsets.size() - 1;
+    // Local id of a mesh triangle: a table when the set is a large part of the mesh, else a
+    // binary search in (global, local) pairs.
+    std::vector<std::uint32_t> table;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
+    if (8 * m >= nt) {
+      table.assign(nt, invalid_id);
+      for (std::size_t i = 0; i < m; ++i) table[triangles[i]] = static_cast<std::uint32_t>(i);
+    } else {
+      sorted.resize(m);
+      for (std::size_t i = 0; i < m; ++i) sorted[i] = {triangles[i], static_cast<std::uint32_t>(i)};
+      std::sort(sorted.begin(), sorted.end());
     }
-    std::vector<std::uint8_t> similar(nb.size());
-    for (std::uint32_t i = 0; i < m; ++i)
-      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-        const std::uint32_t j = nb[k];
-        const std::uint32_t* first = nb.data() + offsets[j];
-        const std::uint32_t* last = nb.data() + offsets[j + 1];
-        const std::uint32_t* at = j < i ? std::find(first, last, i) : last;  // j's side, done already
-        similar[k] = at != last ? similar[static_cast<std::size_t>(at - nb.data())] : s.within(i, j, threshold);
-      }
+    auto local_of = [&](std::uint32_t t) {
+      if (!table.empty()) return table[t];
+      const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
+      return it != sorted.end() && it->first == t ? it->second : invalid_id;
+    };
     std::vector<float> out(m * n, 0.0f);  // unseen rows stay 0
     std::vector<double> acc(n);
-    for (std::size_t i = 0; i < m; ++i) {
-      if (s.unseen(static_cast<std::uint32_t>(i))) continue;
+    for (std::uint32_t i = 0; i < m; ++i) {
+      if (s.unseen(i)) continue;
       std::fill(acc.begin(), acc.end(), 0.0);
       std::size_t count = 0;
       auto add = [&](std::size_t j) {
@@ -276,8 +270,11 @@ struct prepared_visibility_channel {
         ++count;
       };
       add(i);
-      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k)
-        if (similar[k]) add(nb[k]);
+      const std::uint32_t g = triangles[i];
+      for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
+        const std::uint32_t j = local_of(neighbours[k]);
+        if (j != invalid_id && !s.unseen(j) && s.within(i, j, threshold)) add(j);
+      }
       for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
     }
     s.rows_ = std::move(out);
