@@ -215,6 +215,35 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
   REQUIRE(p2->visible == p->visible);
 }
 
+TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][visibility]") {
+  // A bumpy sphere under a roof: rows from alike to disjoint, unseen triangles under a cap.
+  indexed_mesh scene = support::make_uv_sphere(16, 10);
+  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
+  test::brute_tracer tracer(scene);
+  auto topo = build_topology(scene);
+  REQUIRE(topo.ok());
+  serial_executor exec;
+  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
+  REQUIRE(p.ok());
+  auto s = p->init(all_triangles(scene.triangles.size()));
+  REQUIRE(s.ok());
+  std::size_t checked = 0, below = 0;
+  const auto m = static_cast<std::uint32_t>(s->element_count());
+  for (std::uint32_t a = 0; a < m; ++a)
+    for (std::uint32_t b = a; b < m; b += 7) {
+      const double js = s->divergence(a, b);
+      for (double th : {0.0, 0.01, 0.1, 0.48, 0.9, 1.0, js, std::nextafter(js, 0.0), std::nextafter(js, 2.0), js + 1e-10,
+                        js - 1e-10, js + 2e-9}) {
+        REQUIRE(s->within(a, b, th) == (js <= th));
+        ++checked;
+        below += js <= th;
+      }
+    }
+  REQUIRE(checked > 10000);
+  REQUIRE(below > checked / 4);
+  REQUIRE(below < checked);
+}
+
 TEST_CASE("stretch binned rows approach exact rows as K grows", "[cluster][stretch]") {
   const auto m = support::make_uv_sphere(24, 16);
   const auto raw = texture_stretch(m);

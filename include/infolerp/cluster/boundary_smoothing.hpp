@@ -55,7 +55,7 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
 // Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
 // plus O(band · log band); divergences only for the boundary and band triangles.
-// Allocation O(M).
+// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call).
 template <class S, class M>
 std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
                                 double threshold, region_growing_result& r) {
@@ -66,6 +66,14 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::vector<glm::uvec3> tri(n);
   for (std::size_t i = 0; i < n; ++i) tri[i] = mesh_triangle(m, triangles[i]);
   std::vector<std::uint32_t>& label = r.cluster_of;
+  // The mesh edge (key) crossed by each graph slot, found once; no_edge when none is shared.
+  constexpr std::uint64_t no_edge = ~std::uint64_t{0};
+  std::vector<std::uint64_t> slot_edge(g.neighbours.size());
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot) {
+      std::uint32_t a, b;
+      slot_edge[slot] = detail::shared_edge(tri[i], tri[g.neighbours[slot]], a, b) ? detail::edge_key(a, b) : no_edge;
+    }
 
   // Neighbouring cluster pairs, ascending.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
@@ -100,13 +108,11 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     for (std::uint32_t i : members) {
       const std::uint32_t other = label[i] == ca ? cb : ca;
       bool on = false;
-      for (std::uint32_t j : g.neighbours_of(i)) {
-        std::uint32_t a, b;
-        if (label[j] == other && detail::shared_edge(tri[i], tri[j], a, b)) {
-          if (label[i] == ca) boundary.push_back(detail::edge_key(a, b));
+      for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot)
+        if (label[g.neighbours[slot]] == other && slot_edge[slot] != no_edge) {
+          if (label[i] == ca) boundary.push_back(slot_edge[slot]);
           on = true;
         }
-      }
       if (on) frontier.push_back(i);
     }
     std::sort(boundary.begin(), boundary.end());
@@ -162,17 +168,15 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     std::vector<std::uint64_t> edges(boundary);
     for (std::uint32_t i : band)
       for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tri[i][c], b = tri[i][(c + 1) % 3];
+        const std::uint64_t key = detail::edge_key(tri[i][c], tri[i][(c + 1) % 3]);
         int across = 0;
         bool inside = true;
-        for (std::uint32_t j : g.neighbours_of(i)) {
-          std::uint32_t x, y;
-          if (detail::shared_edge(tri[i], tri[j], x, y) && detail::edge_key(x, y) == detail::edge_key(a, b)) {
+        for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot)
+          if (slot_edge[slot] == key) {
             ++across;
-            inside = inside && (label[j] == ca || label[j] == cb);
+            inside = inside && (label[g.neighbours[slot]] == ca || label[g.neighbours[slot]] == cb);
           }
-        }
-        if (across == 1 && inside) edges.push_back(detail::edge_key(a, b));
+        if (across == 1 && inside) edges.push_back(key);
       }
     std::sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
@@ -233,11 +237,10 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
       while (!stack.empty()) {
         const std::uint32_t t = stack.back();
         stack.pop_back();
-        for (std::uint32_t j : g.neighbours_of(t)) {
+        for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
+          const std::uint32_t j = g.neighbours[slot];
           if (region[j] != invalid_id || (label[j] != ca && label[j] != cb)) continue;
-          std::uint32_t a, b;
-          if (detail::shared_edge(tri[t], tri[j], a, b) && std::binary_search(path.begin(), path.end(), detail::edge_key(a, b)))
-            continue;
+          if (slot_edge[slot] != no_edge && std::binary_search(path.begin(), path.end(), slot_edge[slot])) continue;
           region[j] = regions;
           stack.push_back(j);
         }

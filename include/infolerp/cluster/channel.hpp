@@ -40,6 +40,8 @@ namespace infolerp {
 // Optional, used when present:
 //   divergences(a, first, out) -> out[i] = divergence(a, first + i), a batch that may share work
 //   all_alike() -> bool: every row is identical (the clustering then skips all work)
+//   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th (false
+//       may mean either); growth then needs the exact JS only where two seeds claim an element
 // Thread-safety: const members are called concurrently from the executor's threads.
 template <class S>
 concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {
@@ -91,8 +93,9 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 //
 // Kernel requirements: class_count(), count(c) (elements in class c, as double),
 //   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
-// Allocation: O(U) at construction; divergence() allocates 2U doubles per call, divergences()
-// once per call. Thread-safe for concurrent const calls.
+// Allocation: O(U) at construction; divergence(), divergences() and mutual_information() build
+// rows in per-thread scratch buffers (2U doubles per thread, allocated once and reused).
+// Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
  public:
@@ -129,14 +132,14 @@ class direct_channel_state {
   }
 
   double mutual_information(std::uint32_t a) const {
-    std::vector<double> r(class_count());
+    const std::span<double> r = scratch(0);
     row(a, r);
     return element_mutual_information(r, output_);
   }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
-    std::vector<double> ra(class_count()), rb(class_count());
+    const std::span<double> ra = scratch(0), rb = scratch(1);
     row(a, ra);
     row(b, rb);
     return js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5);
@@ -144,7 +147,7 @@ class direct_channel_state {
 
   // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
   void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
-    std::vector<double> ra(class_count()), rb(class_count());
+    const std::span<double> ra = scratch(0), rb = scratch(1);
     row(a, ra);
     for (std::size_t i = 0; i < out.size(); ++i) {
       const auto b = static_cast<std::uint32_t>(first + i);
@@ -158,6 +161,14 @@ class direct_channel_state {
   }
 
  private:
+  // Scratch row `which` (0 or 1) of class_count() doubles, per thread.
+  std::span<double> scratch(std::size_t which) const {
+    thread_local std::vector<double> buffers[2];
+    std::vector<double>& b = buffers[which];
+    if (b.size() < class_count()) b.resize(class_count());
+    return {b.data(), class_count()};
+  }
+
   std::vector<std::uint32_t> class_of_;
   Kernel kernel_;
   std::vector<double> output_;

@@ -10,7 +10,10 @@
 //   Th = 1, or all rows alike   one cluster per connected component, no divergence evaluated.
 //   seeds        first: the class with minimum I(x;Y); next: the class with maximum summed JS
 //                to the seeds so far among those with JS > Th to every seed; stop when none.
-//                Each seed's JS column (all classes) is computed once, in parallel.
+//                Lazy: a seed's JS is evaluated (in parallel) only for the classes still
+//                candidates, and during growth only where its frontier arrives, once per
+//                (seed, class); with the state's surely_within, growth evaluates it exactly
+//                only where two seeds claim an element in the same ring. Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
@@ -81,14 +84,38 @@ struct region_growing_result {
 
 namespace detail {
 
-// out[c] = JS(a, c) for every class c, in parallel chunks (each slot independent).
+// JS column entries that are not a value (JS is never negative): not evaluated (yet), and
+// "JS <= Th − 1e-9 by the state's surely_within, value not evaluated".
+inline constexpr float js_unknown = -1.0f;
+inline constexpr float js_bounded = -3.0f;
+
+template <class S>
+concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
+  { s.surely_within(a, a, th) } -> std::convertible_to<bool>;
+};
+
+// col[c] = JS(a, c) for the classes c listed in `which` (ascending, distinct), in parallel chunks
+// (each slot independent). With a threshold (>= 0), js_bounded where the state's
+// surely_within(a, c, threshold) holds. Runs of consecutive classes go through the state's batch
+// divergences() when it has one.
 template <class S, class E>
-void js_column(const S& s, std::uint32_t a, std::span<float> out, std::size_t grain, E& exec) {
-  for_each_chunk(exec, out.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
-    if constexpr (requires { s.divergences(a, std::uint32_t{}, out.subspan(b, e - b)); }) {
-      s.divergences(a, static_cast<std::uint32_t>(b), out.subspan(b, e - b));
-    } else {
-      for (std::size_t c = b; c < e; ++c) out[c] = static_cast<float>(s.divergence(a, static_cast<std::uint32_t>(c)));
+void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, std::span<float> col, std::size_t grain,
+                E& exec, double threshold = -1.0) {
+  for_each_chunk(exec, which.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e;) {
+      const std::uint32_t c = which[i];
+      if constexpr (has_surely_within<S>) {
+        col[c] = threshold >= 0.0 && s.surely_within(a, c, threshold) ? js_bounded : static_cast<float>(s.divergence(a, c));
+        ++i;
+      } else if constexpr (requires { s.divergences(a, c, col.subspan(c, 1)); }) {
+        std::size_t j = i + 1;
+        while (j < e && which[j] == which[j - 1] + 1) ++j;
+        s.divergences(a, c, col.subspan(c, j - i));
+        i = j;
+      } else {
+        col[c] = static_cast<float>(s.divergence(a, c));
+        ++i;
+      }
     }
   });
 }
@@ -116,8 +143,13 @@ inline void component_clusters(const element_graph& g, region_growing_result& r)
 }  // namespace detail
 
 // §3.2.2 seed selection. Returns the seed classes in order; `columns[k]` receives seed k's JS to
-// every class. Preconditions: 0 < threshold < 1, class_count() >= 1.
-// Complexity: U MI evaluations + one JS column (U divergences) per seed. Allocation U floats per seed.
+// every class that was still a candidate (JS > Th to seeds 0..k-1) when seed k was chosen; the
+// other entries are js_unknown. Lazy: a class with JS <= Th to some seed can never become a
+// seed, and its summed JS no longer matters, so it is not evaluated against later seeds (the
+// seeds are the same as with full columns).
+// Preconditions: 0 < threshold < 1, class_count() >= 1.
+// Complexity: U MI evaluations + one divergence per (seed, class still a candidate), at most
+// U per seed. Allocation U floats per seed.
 template <class S, class E>
 std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_t grain, E& exec,
                                         std::vector<std::vector<float>>& columns) {
@@ -132,19 +164,23 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
     if (mi[c] < mi[next]) next = c;
   std::vector<std::uint32_t> seeds;
   std::vector<double> sum(u, 0.0);
-  std::vector<float> min_js(u, std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> candidates(u);  // ascending
+  std::iota(candidates.begin(), candidates.end(), 0u);
   columns.clear();
   for (;;) {
     seeds.push_back(next);
-    columns.emplace_back(u);
-    detail::js_column(s, next, std::span<float>(columns.back()), grain, exec);
-    const auto& col = columns.back();
+    columns.emplace_back(u, detail::js_unknown);
+    auto& col = columns.back();
+    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec);
     std::uint32_t best = invalid_id;
-    for (std::uint32_t c = 0; c < u; ++c) {
+    std::size_t kept = 0;
+    for (std::uint32_t c : candidates) {
       sum[c] += col[c];
-      min_js[c] = std::min(min_js[c], col[c]);
-      if (static_cast<double>(min_js[c]) > threshold && (best == invalid_id || sum[c] > sum[best])) best = c;
+      if (!(static_cast<double>(col[c]) > threshold)) continue;
+      candidates[kept++] = c;
+      if (best == invalid_id || sum[c] > sum[best]) best = c;
     }
+    candidates.resize(kept);
     if (best == invalid_id) break;
     next = best;
   }
@@ -153,7 +189,8 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
 
 // §3.2 for one channel on one set: seeds, parallel growth, sequential pass, merging.
 // Errors: threshold or min_cluster_fraction outside [0,1] or NaN, graph/state size mismatch,
-// empty set. Complexity: dominated by the JS columns of the seeds (see select_seeds), plus
+// empty set. Complexity: dominated by the seeds' divergences (see select_seeds; growth adds at
+// most one per (seed, class) its frontier reaches), plus
 // O(M·degree) for growth and O(M·degree) per merging pass. Allocation O(M + seeds·U).
 // Thread-safety: the state's const members are called from the executor's threads.
 template <class S, class E>
@@ -209,16 +246,41 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   }
   std::vector<float> best_js(m, std::numeric_limits<float>::infinity());
   std::vector<std::uint32_t> best_k(m, invalid_id), touched;
+  std::vector<std::vector<std::uint32_t>> missing(k0);  // column entries this ring needs
+  constexpr float js_pending = -2.0f;
   for (bool any = true; any;) {
     touched.clear();
+    for (std::uint32_t k = 0; k < k0; ++k) {
+      missing[k].clear();
+      for (std::uint32_t f : frontier[k])
+        for (std::uint32_t n : g.neighbours_of(f))
+          if (label[n] == invalid_id && columns[k][cls[n]] == detail::js_unknown) {
+            columns[k][cls[n]] = js_pending;
+            missing[k].push_back(cls[n]);
+          }
+      std::sort(missing[k].begin(), missing[k].end());
+      detail::js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), o.grain, exec, th);
+    }
+    // A js_bounded entry is similar; its value is needed only when a second seed claims the
+    // same element in this ring (then both values are made exact, in this fixed order).
+    auto exact = [&](std::uint32_t k, std::uint32_t c) {
+      float& js = columns[k][c];
+      if (js == detail::js_bounded) js = static_cast<float>(s.divergence(seed_classes[k], c));
+      return js;
+    };
     for (std::uint32_t k = 0; k < k0; ++k)
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f)) {
           if (label[n] != invalid_id) continue;
-          const float js = columns[k][cls[n]];
-          if (!is_similar(js, th)) continue;
-          if (best_k[n] == invalid_id) touched.push_back(n);
-          if (js < best_js[n] || (js == best_js[n] && k < best_k[n])) {
+          float js = columns[k][cls[n]];
+          if (js != detail::js_bounded && !is_similar(js, th)) continue;
+          if (best_k[n] == invalid_id) {
+            touched.push_back(n);
+          } else if (best_k[n] != k) {
+            js = exact(k, cls[n]);
+            best_js[n] = exact(best_k[n], cls[n]);
+          }
+          if (best_k[n] == invalid_id || js < best_js[n] || (js == best_js[n] && k < best_k[n])) {
             best_js[n] = js;
             best_k[n] = k;
           }

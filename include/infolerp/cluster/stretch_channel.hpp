@@ -65,7 +65,7 @@ inline double degener_stretch(const triangle_corners& c, glm::dvec2 uv0, glm::dv
   const double s1 = qn + rn, s2 = std::abs(qn - rn);
   if (!(s2 > 0.0) || !std::isfinite(s1)) return std::numeric_limits<double>::infinity();
   const double area = s1 * s2;
-  const double value = (s1 / s2 + s2 / s1) * std::pow(area + 1.0 / area, theta);
+  const double value = (s1 / s2 + s2 / s1) * (theta == 1.0 ? area + 1.0 / area : std::pow(area + 1.0 / area, theta));  // pow(x, 1) == x
   return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
 }
 

@@ -15,7 +15,8 @@
 // class: JS between two of them is 0, between one of them and a seen triangle 1, and their
 // I(t;V) is +inf so they are never the first seed.
 // Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
-// its edge neighbours in the set with JS <= Th.
+// its edge neighbours in the set with JS <= Th (most tests are decided by an upper bound on JS
+// without logarithms, see visibility_state::surely_within).
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
@@ -124,11 +125,33 @@ class visibility_state {
     if (ua || ub) return ua == ub ? 0.0 : 1.0;
     return js_channel(row(a), row(b), p_[a], p_[b]);
   }
+  // True only if divergence(a, b) <= threshold, decided without logarithms by the upper bound
+  //   JS_π(P,Q) <= h(π)·Σ_{p>q}(p − q) + h(1 − π)·Σ_{q>p}(q − p) <= h_max·Σ|p − q|,
+  // h(x) = −x·log₂x <= h_max = 1/(e·ln 2) ≈ 0.53074 (the per-bin term f(p,q) is convex and
+  // 1-homogeneous, so for p >= q f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·h(π), and
+  // symmetrically). The bound must be 1e-9 below the threshold (the kernel is accurate to
+  // ~1e-15), so a true answer always agrees with divergence(); false means "not decided".
+  // O(N), no allocation.
+  bool surely_within(std::uint32_t a, std::uint32_t b, double threshold) const {
+    if (a == b || unseen(a) || unseen(b)) return false;
+    const float* ra = rows_.data() + std::size_t{a} * n_;
+    const float* rb = rows_.data() + std::size_t{b} * n_;
+    double l1[4] = {};  // 4 independent sums
+    std::size_t v = 0;
+    for (; v + 4 <= n_; v += 4)
+      for (std::size_t lane = 0; lane < 4; ++lane)
+        l1[lane] += std::abs(static_cast<double>(ra[v + lane]) - static_cast<double>(rb[v + lane]));
+    for (; v < n_; ++v) l1[0] += std::abs(static_cast<double>(ra[v]) - static_cast<double>(rb[v]));
+    constexpr double h_max = 0.53074;  // > 1/(e·ln 2) = 0.5307378...
+    return h_max * ((l1[0] + l1[1]) + (l1[2] + l1[3])) <= threshold - 1e-9;
+  }
+  // divergence(a, b) <= threshold, by the bound where it decides.
+  bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
+    return surely_within(a, b, threshold) || divergence(a, b) <= threshold;
+  }
   double mutual_information(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
-    const auto r = row(t);
-    std::vector<double> d(r.begin(), r.end());
-    return element_mutual_information(d, output_);
+    return element_mutual_information(row(t), output_);
   }
 
  private:
@@ -155,17 +178,23 @@ struct prepared_visibility_channel {
   }
 
   // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
-  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising,
-  // + O(M log M) to find neighbours in the set). Allocation O(M·N) floats.
+  // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, + O(M log M)
+  // to find neighbours in the set when it is under 1/8 of the mesh). Allocation O(M·N) floats
+  // (+ T ids for a set of at least 1/8 of the mesh).
   result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
     const std::size_t nt = neighbour_offsets.empty() ? 0 : neighbour_offsets.size() - 1;
     for (std::uint32_t t : triangles)
       if (t >= nt) return make_error(errc::index_out_of_range, t, "visibility channel: triangle ", t, " out of range");
+    // OR takes samples + 1 values: tabled (the same bits as occlusion_ratio, no division per entry).
+    std::vector<double> ratio(std::size_t{samples} + 1);
+    for (std::uint32_t c = 0; c <= samples; ++c) ratio[c] = static_cast<double>(c) / static_cast<double>(samples);
     std::vector<double> weight(n, 0.0);  // Σ_t OR(t, v)
-    for (std::uint32_t t : triangles)
-      for (std::size_t v = 0; v < n; ++v) weight[v] += occlusion_ratio(t, v);
+    for (std::uint32_t t : triangles) {
+      const std::uint8_t* vis = visible.data() + std::size_t{t} * n;
+      for (std::size_t v = 0; v < n; ++v) weight[v] += ratio[vis[v]];
+    }
     std::size_t active = 0;
     for (double w : weight) active += w > 0.0 ? 1 : 0;
     visibility_state s;
@@ -179,11 +208,16 @@ struct prepared_visibility_channel {
     }
     const double pv = 1.0 / static_cast<double>(active);
     for (std::size_t v = 0; v < n; ++v) s.output_[v] = weight[v] > 0.0 ? pv : 0.0;
+    // p(t|v) = OR(t,v) / weight[v] also takes few values: tabled per (visible count, v).
+    std::vector<double> ptv_of((std::size_t{samples} + 1) * n);
+    for (std::uint32_t c = 0; c <= samples; ++c)
+      for (std::size_t v = 0; v < n; ++v) ptv_of[c * n + v] = weight[v] > 0.0 ? ratio[c] / weight[v] : 0.0;
     std::vector<double> ptv(n);
     for (std::size_t i = 0; i < m; ++i) {
+      const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
       double pt = 0.0;
       for (std::size_t v = 0; v < n; ++v) {
-        ptv[v] = weight[v] > 0.0 ? occlusion_ratio(triangles[i], v) / weight[v] : 0.0;
+        ptv[v] = ptv_of[vis[v] * n + v];
         pt += pv * ptv[v];
       }
       s.p_[i] = pt;
@@ -201,15 +235,30 @@ struct prepared_visibility_channel {
 
  private:
   // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th}.
+  // The tests go through visibility_state::within, which its bound mostly decides without JS.
   void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s) const {
-    const std::size_t m = triangles.size(), n = viewpoints;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> local(m);  // (global, local), sorted
-    for (std::size_t i = 0; i < m; ++i) local[i] = {triangles[i], static_cast<std::uint32_t>(i)};
-    std::sort(local.begin(), local.end());
-    std::vector<float> out(s.rows_);
+    const std::size_t m = triangles.size(), n = viewpoints, nt = neighbour_offsets.size() - 1;
+    // Local id of a mesh triangle: a table when the set is a large part of the mesh, else a
+    // binary search in (global, local) pairs.
+    std::vector<std::uint32_t> table;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
+    if (8 * m >= nt) {
+      table.assign(nt, invalid_id);
+      for (std::size_t i = 0; i < m; ++i) table[triangles[i]] = static_cast<std::uint32_t>(i);
+    } else {
+      sorted.resize(m);
+      for (std::size_t i = 0; i < m; ++i) sorted[i] = {triangles[i], static_cast<std::uint32_t>(i)};
+      std::sort(sorted.begin(), sorted.end());
+    }
+    auto local_of = [&](std::uint32_t t) {
+      if (!table.empty()) return table[t];
+      const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
+      return it != sorted.end() && it->first == t ? it->second : invalid_id;
+    };
+    std::vector<float> out(m * n, 0.0f);  // unseen rows stay 0
     std::vector<double> acc(n);
-    for (std::size_t i = 0; i < m; ++i) {
-      if (s.unseen(static_cast<std::uint32_t>(i))) continue;
+    for (std::uint32_t i = 0; i < m; ++i) {
+      if (s.unseen(i)) continue;
       std::fill(acc.begin(), acc.end(), 0.0);
       std::size_t count = 0;
       auto add = [&](std::size_t j) {
@@ -219,11 +268,8 @@ struct prepared_visibility_channel {
       add(i);
       const std::uint32_t g = triangles[i];
       for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
-        const auto it = std::lower_bound(local.begin(), local.end(), std::pair{neighbours[k], 0u});
-        if (it == local.end() || it->first != neighbours[k]) continue;
-        const std::uint32_t j = it->second;
-        if (s.unseen(j)) continue;
-        if (s.divergence(static_cast<std::uint32_t>(i), j) <= threshold) add(j);
+        const std::uint32_t j = local_of(neighbours[k]);
+        if (j != invalid_id && !s.unseen(j) && s.within(i, j, threshold)) add(j);
       }
       for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
     }

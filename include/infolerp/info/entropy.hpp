@@ -37,13 +37,14 @@ inline double entropy(std::span<const double> p) noexcept {
 // I(x;Y) = Σ_y p(y|x) log₂(p(y|x)/p(y)): how much observing x tells about Y (KL divergence of
 // the row from the output distribution). Preconditions: row and p_y normalised, same size,
 // p_y(y) > 0 wherever row(y) > 0 (true when p_y is the channel's output distribution; bins
-// where it fails are skipped). O(Y), no allocation.
+// where it fails are skipped). O(Y), no allocation. Vectorised (info/jensen_shannon.hpp's
+// dispatch): each term p·log₂(p/q) as log2_accurate gives it, summed in 4 interleaved partial
+// sums. A float row (the visibility channel stores its rows as floats) is read as doubles.
 inline double element_mutual_information(std::span<const double> row, std::span<const double> p_y) noexcept {
-  double sum = 0.0;
-  const std::size_t n = std::min(row.size(), p_y.size());
-  for (std::size_t y = 0; y < n; ++y)
-    if (row[y] > 0.0 && p_y[y] > 0.0 && row[y] != p_y[y]) sum += row[y] * detail::log2_accurate(row[y] / p_y[y]);
-  return std::max(sum, 0.0);
+  return detail::kl_kernel(row.data(), p_y.data(), std::min(row.size(), p_y.size()));
+}
+inline double element_mutual_information(std::span<const float> row, std::span<const double> p_y) noexcept {
+  return detail::kl_kernel(row.data(), p_y.data(), std::min(row.size(), p_y.size()));
 }
 
 // p(y) = Σ_x p(x) p(y|x). Preconditions: rows.size() is a multiple of p_x.size() (>0).
