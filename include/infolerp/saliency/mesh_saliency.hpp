@@ -389,6 +389,15 @@ INFOLERP_SALIENCY_INLINE void store_lanes(double* p, const V& v) {
   std::memcpy(p, &v, sizeof v);
 }
 
+inline constexpr double lane_numbers[block_lanes] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+// The sums of the points, by blocks of 8 sorted points: per block, per σ, 8 numerators then 8
+// denominators (one 64-byte line each), so that a block's sums for every σ are adjacent (few
+// pages per pass: the kernel is memory-bound there). Point j's numerator for σ u:
+inline double* point_sums(double* sums, std::size_t L, std::size_t j, std::size_t u) {
+  return sums + j / block_lanes * (2 * block_lanes * L) + u * 2 * block_lanes + j % block_lanes;
+}
+
 // A tile: the columns [cx0, cx1) × [cy0, cy1) of a column_grid.
 struct column_tile {
   std::uint32_t cx0, cx1, cy0, cy1;
@@ -407,16 +416,16 @@ struct column_tile {
 // the sorted order (its own column above i, then the later columns within 2σ_max), 8
 // candidates j at a time, σ from the largest down, stopping at the first ball that holds none
 // of the 8. A pair's weights are added to i's sums (registers, one partial sum per lane, added
-// in a fixed order when i is done) and to j's sums (num/den[u * stride + j], in memory). Writes
+// in a fixed order when i is done) and to j's sums (point_sums, in memory). Writes
 // reach the tile's columns and the columns up to `span` later in x and span either side in y;
 // the caller runs tiles whose write sets are disjoint concurrently, in a fixed order otherwise.
 // LC >= the number of σ: the σ loop is unrolled (8 at a time) so that, with LC = 8, i's sums
 // stay in registers (AVX-512: 16 of its 32).
 template <class V, std::size_t LC>
 INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
-                                          column_tile tile, double* num, double* den) {
+                                          column_tile tile, double* sums) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
-  const std::size_t L = t.r2.size(), stride = g.stride;
+  const std::size_t L = t.r2.size();
   const double r2max = t.r2[L - 1];
   const double *px_all = g.row(0), *py_all = g.row(1), *pz_all = g.row(2), *pc_all = g.row(3);
   for (std::uint32_t cx = tile.cx0; cx < tile.cx1; ++cx)
@@ -440,27 +449,23 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
                                    : static_cast<std::size_t>(std::lower_bound(zb, ze, zi - half) - pz_all);
             // Blocks start at multiples of 8, so that j's sums are whole aligned vectors.
             for (std::size_t j = j0 / block_lanes * block_lanes; j < j1; j += block_lanes) {
-              const double *xs = px_all + j, *ys = py_all + j, *zs = pz_all + j, *cs = pc_all + j;
-              double px[block_lanes], py[block_lanes], pz[block_lanes], pc[block_lanes];
               const bool partial = j < j0 || j + block_lanes > j1;
-              if (partial) {  // lanes outside [j0, j1) become points outside every ball
-                // At z = +Inf a pad's d² is +Inf at any scale (an absolute offset such as
-                // zi + 4·half + 1 falls inside the ball when 2σ_max > 1 mesh unit, or is absorbed
-                // by a large zi); its weight is masked off bitwise like any point outside.
-                for (std::size_t l = 0; l < block_lanes; ++l) {
-                  const bool in = j + l >= j0 && j + l < j1;
-                  px[l] = in ? xs[l] : xi, py[l] = in ? ys[l] : yi;
-                  pz[l] = in ? zs[l] : std::numeric_limits<double>::infinity(), pc[l] = in ? cs[l] : 0.0;
-                }
-                xs = px, ys = py, zs = pz, cs = pc;
-              }
               V d2[G], c[G];
               for (std::size_t k = 0; k < G; ++k) {
-                const std::size_t o = k * width;
+                const std::size_t o = j + k * width;
                 V vx, vy, vz;
-                load_lanes(vx, xs + o), load_lanes(vy, ys + o), load_lanes(vz, zs + o), load_lanes(c[k], cs + o);
+                load_lanes(vx, px_all + o), load_lanes(vy, py_all + o), load_lanes(vz, pz_all + o), load_lanes(c[k], pc_all + o);
                 const V dx = vx - xi, dy = vy - yi, dz = vz - zi;
                 d2[k] = dx * dx + dy * dy + dz * dz;
+                if (partial) {  // lanes outside [j0, j1) (other points, or the rows' padding) get d² = +Inf
+                  V lane;
+                  load_lanes(lane, lane_numbers + k * width);
+                  const V after_j0 = lane + (static_cast<double>(j) - static_cast<double>(j0) + 0.5);
+                  const V before_j1 = lane * -1.0 + (static_cast<double>(j1) - static_cast<double>(j) - 0.5);
+                  V pad;
+                  keep(pad, after_j0 * before_j1 <= 0.0, lane * 0.0 + std::numeric_limits<double>::infinity());
+                  d2[k] = d2[k] + pad;
+                }
               }
               V nearest = d2[0];
               for (std::size_t k = 1; k < G; ++k) lane_min(nearest, d2[k]);
@@ -486,8 +491,8 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
                   acc_d[s][k] = acc_d[s][k] + m;
                   md[k] = m, mn[k] = m * ci;
                 }
-                double* nj = num + u * stride + j;
-                double* dj = den + u * stride + j;
+                double* nj = point_sums(sums, L, j, u);
+                double* dj = nj + block_lanes;
                 if (!partial) {
                   for (std::size_t k = 0; k < G; ++k) {
                     V a, b;
@@ -510,8 +515,9 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
           std::memcpy(d, acc_d[s], sizeof d);
           for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
             for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
-          num[(L - 1 - s) * stride + i] += n[0] + ci;  // i itself: weight 1
-          den[(L - 1 - s) * stride + i] += d[0] + 1.0;
+          double* ni = point_sums(sums, L, i, L - 1 - s);
+          ni[0] += n[0] + ci;  // i itself: weight 1
+          ni[block_lanes] += d[0] + 1.0;
         }
       }
 }
@@ -519,17 +525,17 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
 // One tile with vectors V, 8 or 32 σ slots.
 template <class V>
 INFOLERP_SALIENCY_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
-                                              column_tile tile, double* num, double* den) {
-  if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, num, den);
-  gather_tile<V, 32>(g, t, span, tile, num, den);
+                                              column_tile tile, double* sums) {
+  if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, sums);
+  gather_tile<V, 32>(g, t, span, tile, sums);
 }
 
 inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, column_tile tile,
-                                 double* num, double* den) {
+                                 double* sums) {
 #if defined(__GNUC__) || defined(__clang__)
-  gather_tile_any<v2d>(g, t, span, tile, num, den);
+  gather_tile_any<v2d>(g, t, span, tile, sums);
 #else
-  gather_tile_any<lanes_fallback>(g, t, span, tile, num, den);
+  gather_tile_any<lanes_fallback>(g, t, span, tile, sums);
 #endif
 }
 
@@ -539,14 +545,13 @@ inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std
 #define INFOLERP_SALIENCY_X86 1
 using v8d = double __attribute__((vector_size(64)));
 __attribute__((target("avx2,fma"))) inline void gather_tile_avx2(const column_grid& g, const sigma_table& t,
-                                                                 std::uint32_t span, column_tile tile, double* num,
-                                                                 double* den) {
-  gather_tile_any<v4d>(g, t, span, tile, num, den);
+                                                                 std::uint32_t span, column_tile tile, double* sums) {
+  gather_tile_any<v4d>(g, t, span, tile, sums);
 }
 __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const column_grid& g, const sigma_table& t,
                                                                            std::uint32_t span, column_tile tile,
-                                                                           double* num, double* den) {
-  gather_tile_any<v8d>(g, t, span, tile, num, den);
+                                                                           double* sums) {
+  gather_tile_any<v8d>(g, t, span, tile, sums);
 }
 // 2: AVX-512F, 1: AVX2 and FMA, 0: neither.
 inline int x86_vector_level() {
@@ -575,9 +580,8 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   const column_grid g = make_column_grid(pg, rmax / 3.0);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
   const std::size_t stride = g.stride;
-  std::vector<double> sums(2 * L * stride + block_lanes, 0.0);  // L num rows, then L den rows
-  double* num = sums.data() + aligned_offset(sums);
-  double* den = num + L * stride;
+  std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
+  double* sums = storage.data() + aligned_offset(storage);
 #ifdef INFOLERP_SALIENCY_X86
   const int level = x86_vector_level();
 #endif
@@ -599,21 +603,24 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
       for (std::size_t k = b; k < e; ++k) {
 #ifdef INFOLERP_SALIENCY_X86
         if (level == 2) {
-          gather_tile_avx512(g, t, span, tiles[k], num, den);
+          gather_tile_avx512(g, t, span, tiles[k], sums);
           continue;
         }
         if (level == 1) {
-          gather_tile_avx2(g, t, span, tiles[k], num, den);
+          gather_tile_avx2(g, t, span, tiles[k], sums);
           continue;
         }
 #endif
-        gather_tile_portable(g, t, span, tiles[k], num, den);
+        gather_tile_portable(g, t, span, tiles[k], sums);
       }
     });
   }
   std::vector<double> avg(L * P);
   for (std::size_t u = 0; u < L; ++u)
-    for (std::size_t k = 0; k < P; ++k) avg[u * P + g.src[k]] = num[u * stride + k] / den[u * stride + k];
+    for (std::size_t k = 0; k < P; ++k) {
+      const double* nk = point_sums(sums, L, k, u);
+      avg[u * P + g.src[k]] = nk[0] / nk[block_lanes];
+    }
   return avg;
 }
 
