@@ -30,12 +30,13 @@
 // (blocks aligned to multiples of 8 in the sorted order); σ run from the largest down and stop
 // at the first ball that holds none of the 8. Only σ whose double 2σ is not in the set need an
 // exp (3 of the 8 by default): w_σ = w_2σ⁴. A pair's terms go to the vertex's own sums (in
-// registers, 8 lane sums added pairwise at the end) and to the candidates' sums (in memory).
+// registers, 8 lane sums added pairwise at the end) and to the candidates' sums (in memory, a
+// block's sums for every σ side by side).
 // Determinism: tiles of 3 × 3 columns write only their own and neighbouring tiles' vertices, so
 // 6 phases (tile x mod 2, tile y mod 3) run one after another, the tiles of a phase in parallel
-// with disjoint writes; each vertex receives its terms in an order fixed by the data, and the
-// result has identical bits for any executor and thread count. Memory O(V·σs); pairs are never
-// stored.
+// (largest first) with disjoint writes; each vertex receives its terms in an order fixed by the
+// data, and the result has identical bits for any executor and thread count. Memory O(V·σs);
+// pairs are never stored.
 // Vector code: GCC/Clang vector extensions, 2 doubles (SSE2, NEON) in the portable build, plus
 // AVX2+FMA (4) and AVX-512F (8) versions chosen at run time on x86-64 (define
 // INFOLERP_NO_RUNTIME_DISPATCH to always use the portable one, INFOLERP_NO_AVX512 for AVX2 at
@@ -43,9 +44,18 @@
 // a plain 4-double struct. exp(−x) on [0, 2] (the only range the ball cutoff produces) is a
 // polynomial fit, relative error ~1e-16.
 // Measured (refined_elephant subdivided once, 177,852 vertices, 584M unordered pairs within
-// 2σ_max; 2-core Intel Xeon VM with AVX-512, shared, load average 4.4; CPU time of the whole call,
-// 1 thread): 1.93 s AVX-512, 2.65 s AVX2, 4.1 s portable; the previous kernel (each pair from
-// both ends, AVX2) took 4.1 s in the same conditions. refined_elephant (44k): 0.20 s (was 0.35).
+// 2σ_max, 750M candidates; 2-core Intel Xeon VM with AVX-512, shared with other jobs; CPU time of
+// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), ~2.5 s AVX2,
+// ~4 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the same
+// machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%, and
+// ~4% of the call is serial (curvature, topology, grids, normalisation), so 2 idle cores need
+// ~0.93 s wall. Where the time goes (AVX-512): exps ~20%, the candidates' sums in memory ~23%.
+// refined_elephant (44k): 0.20 s CPU (was 0.35).
+// Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
+// the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
+// by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
+// computed one block ahead; coordinates interleaved by block; columns 2σ_max/2, /4 or /5 wide
+// (all within noise or slower).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
