@@ -45,12 +45,14 @@
 // polynomial fit, relative error ~1e-16.
 // Measured (refined_elephant subdivided once, 177,852 vertices, 584M unordered pairs within
 // 2σ_max, 750M candidates; 2-core Intel Xeon VM with AVX-512, shared with other jobs; CPU time of
-// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), ~2.5 s AVX2,
-// ~4 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the same
-// machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%, and
-// ~4% of the call is serial (curvature, topology, grids, normalisation), so 2 idle cores need
-// ~0.93 s wall. Where the time goes (AVX-512): exps ~20%, the candidates' sums in memory ~23%.
-// refined_elephant (44k): 0.20 s CPU (was 0.35).
+// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), 2.48 s AVX2,
+// 3.94 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the
+// same machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%
+// (simulated from per-tile times), and ~4% of the call is serial (curvature, topology, grids,
+// normalisation), so 2 idle cores should take ~0.93 s wall (an estimate: see bench_saliency.cpp
+// for what was measured). Where the time goes (AVX-512): exps ~20%, the candidates' sums in
+// memory ~23%. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2, 0.32 s portable (was 0.35
+// s AVX2).
 // Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
 // the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
 // by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
@@ -115,7 +117,7 @@ struct saliency_options {
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   saliency_method method = saliency_method::exact;  // exact or approximate
   double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ (>= 0.5)
-  std::size_t grain = 1;                           // ×64 vertices (exact), ×256 vertices (approximate) per parallel task
+  std::size_t grain = 1;                           // tiles of 3 × 3 columns (exact), ×256 vertices (approximate) per parallel task
 };
 
 struct mesh_saliency {
