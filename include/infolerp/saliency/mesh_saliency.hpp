@@ -243,8 +243,9 @@ struct column_grid {
 };
 
 // Builds a column_grid with columns about `width` wide (wider when needed to keep the column
-// count O(points)). O(P log P).
-inline column_grid make_column_grid(const point_grid& g, double width) {
+// count O(points)). O(P log P); the columns are sorted in parallel through exec.
+template <class E>
+column_grid make_column_grid(E& exec, const point_grid& g, double width) {
   column_grid c;
   const std::size_t P = g.x.size();
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
@@ -269,10 +270,12 @@ inline column_grid make_column_grid(const point_grid& g, double width) {
     std::vector<std::uint32_t> cursor(c.col_start.begin(), c.col_start.end() - 1);
     for (std::size_t k = 0; k < P; ++k) order[cursor[col(k)]++] = static_cast<std::uint32_t>(k);
   }
-  for (std::size_t q = 0; q + 1 < c.col_start.size(); ++q)
-    std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t a, std::uint32_t b) {
-      return g.z[a] != g.z[b] ? g.z[a] < g.z[b] : g.id[a] < g.id[b];
-    });
+  exec.parallel_for(c.col_start.size() - 1, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t q = b; q < e; ++q)
+      std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t x, std::uint32_t y) {
+        return g.z[x] != g.z[y] ? g.z[x] < g.z[y] : g.id[x] < g.id[y];
+      });
+  });
   c.points = P, c.stride = block_stride(P);
   c.rows.assign(4 * c.stride + block_lanes, 0.0);
   c.offset = aligned_offset(c.rows);
@@ -589,7 +592,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
-  const column_grid g = make_column_grid(pg, rmax / 3.0);
+  const column_grid g = make_column_grid(exec, pg, rmax / 3.0);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
   const std::size_t stride = g.stride;
   std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
@@ -628,11 +631,13 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
     });
   }
   std::vector<double> avg(L * P);
-  for (std::size_t u = 0; u < L; ++u)
-    for (std::size_t k = 0; k < P; ++k) {
-      const double* nk = point_sums(sums, L, k, u);
-      avg[u * P + g.src[k]] = nk[0] / nk[block_lanes];
-    }
+  exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t u = b; u < e; ++u)
+      for (std::size_t k = 0; k < P; ++k) {
+        const double* nk = point_sums(sums, L, k, u);
+        avg[u * P + g.src[k]] = nk[0] / nk[block_lanes];
+      }
+  });
   return avg;
 }
 
