@@ -48,16 +48,17 @@
 // the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), 2.48 s AVX2,
 // 3.94 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the
 // same machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%
-// (simulated from per-tile times), and ~4% of the call is serial (curvature, topology, grids,
-// normalisation), so 2 idle cores should take ~0.93 s wall (an estimate: see bench_saliency.cpp
-// for what was measured). Where the time goes (AVX-512): exps ~20%, the candidates' sums in
-// memory ~23%. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2, 0.32 s portable (was 0.35
-// s AVX2).
+// (simulated from per-tile times), and ~0.12 s of the call is serial (curvature 19 ms, topology
+// 31 ms, point grid 20 ms, normalisation 17 ms, ...): BM_Saliency_Exact/2 took 0.925–0.950 s
+// wall on 2 idle cores (goal 1.0 s). Where the kernel's time goes (AVX-512): exps ~20%, the
+// candidates' sums in memory ~23%. On an AVX2-only machine the 1-thread time is ~1.4× (2.48 s):
+// the 1.0 s goal would be missed there. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2,
+// 0.32 s portable (was 0.35 s AVX2).
 // Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
 // the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
 // by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
-// computed one block ahead; coordinates interleaved by block; columns 2σ_max/2, /4 or /5 wide
-// (all within noise or slower).
+// computed one block ahead; coordinates interleaved by block; w_8ε = w_12ε²·exp(−x_12ε/4) instead
+// of an exp; columns 2σ_max/2, /4 or /5 wide (all within noise or slower).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
