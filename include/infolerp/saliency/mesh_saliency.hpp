@@ -24,22 +24,41 @@
 //
 // Exact mode: vertices are sorted into the columns of an xy grid (columns 2σ_max/3 wide), by z
 // inside a column, so the candidates of a vertex are, per nearby column, one contiguous z-run
-// (binary search). Every vertex gathers its own ball sums over its candidates for all distinct
-// σ (σ_i and 2σ_i: 8 values for the default scales) in one pass, 8 candidates at a time with
-// vector code; σ run from the largest down and stop at the first ball that holds none of the 8.
-// Only σ whose double 2σ is not in the set need an exp (3 of the 8 by default): w_σ = w_2σ⁴.
-// Memory O(V·σs); pairs are never stored. Each pair is evaluated from both ends (twice the
-// arithmetic of visiting it once) so that vertices are independent: no write conflicts, and
-// each vertex sums its terms in an order fixed by the data (8 lane sums, added pairwise), so the
-// result has identical bits for any executor and thread count.
+// (binary search). Each pair is evaluated once: a vertex meets the vertices after it in that
+// order (the rest of its own column's run, then the later columns), for all distinct σ (σ_i and
+// 2σ_i: 8 values for the default scales) in one pass, 8 candidates at a time with vector code
+// (blocks aligned to multiples of 8 in the sorted order); σ run from the largest down and stop
+// at the first ball that holds none of the 8. Only σ whose double 2σ is not in the set need an
+// exp (3 of the 8 by default): w_σ = w_2σ⁴. A pair's terms go to the vertex's own sums (in
+// registers, 8 lane sums added pairwise at the end) and to the candidates' sums (in memory, a
+// block's sums for every σ side by side).
+// Determinism: tiles of 3 × 3 columns write only their own and neighbouring tiles' vertices, so
+// 6 phases (tile x mod 2, tile y mod 3) run one after another, the tiles of a phase in parallel
+// (largest first) with disjoint writes; each vertex receives its terms in an order fixed by the
+// data, and the result has identical bits for any executor and thread count. Memory O(V·σs);
+// pairs are never stored.
 // Vector code: GCC/Clang vector extensions, 2 doubles (SSE2, NEON) in the portable build, plus
-// an AVX2+FMA version chosen at run time on x86-64 (define INFOLERP_NO_RUNTIME_DISPATCH to
-// always use the portable one); it differs only by FMA contraction (1e-16 relative per
-// operation). Other compilers get a plain 4-double struct. exp(−x) on [0, 2] (the only range
-// the ball cutoff produces) is a polynomial fit, relative error ~1e-16.
-// Measured (refined_elephant subdivided once, 177,852 vertices, ~586M pairs within 2σ_max,
-// 2-core AMD EPYC VM shared with other jobs): 6.3 s CPU with the AVX2 path (was 22.7 s), i.e.
-// ~3.2 s wall on 2 idle cores; refined_elephant (44k): 0.45 s CPU (AVX2), 0.98 s (portable).
+// AVX2+FMA (4) and AVX-512F (8) versions chosen at run time on x86-64 (define
+// INFOLERP_NO_RUNTIME_DISPATCH to always use the portable one, INFOLERP_NO_AVX512 for AVX2 at
+// most); they differ only by FMA contraction (1e-16 relative per operation). Other compilers get
+// a plain 4-double struct. exp(−x) on [0, 2] (the only range the ball cutoff produces) is a
+// polynomial fit, relative error ~1e-16.
+// Measured (refined_elephant subdivided once, 177,852 vertices, 584M unordered pairs within
+// 2σ_max, 750M candidates; 2-core Intel Xeon VM with AVX-512, shared with other jobs; CPU time of
+// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), 2.48 s AVX2,
+// 3.94 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the
+// same machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%
+// (simulated from per-tile times), and ~0.12 s of the call is serial (curvature 19 ms, topology
+// 31 ms, point grid 20 ms, normalisation 17 ms, ...): BM_Saliency_Exact/2 took 0.925–0.950 s
+// wall on 2 idle cores (goal 1.0 s). Where the kernel's time goes (AVX-512): exps ~20%, the
+// candidates' sums in memory ~23%. On an AVX2-only machine the 1-thread time is ~1.4× (2.48 s):
+// the 1.0 s goal would be missed there. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2,
+// 0.32 s portable (was 0.35 s AVX2).
+// Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
+// the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
+// by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
+// computed one block ahead; coordinates interleaved by block; w_8ε = w_12ε²·exp(−x_12ε/4) instead
+// of an exp; columns 2σ_max/2, /4 or /5 wide (all within noise or slower).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
@@ -99,7 +118,7 @@ struct saliency_options {
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   saliency_method method = saliency_method::exact;  // exact or approximate
   double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ (>= 0.5)
-  std::size_t grain = 1;                           // ×64 vertices (exact), ×256 vertices (approximate) per parallel task
+  std::size_t grain = 1;                           // tiles of 3 × 3 columns (exact), ×256 vertices (approximate) per parallel task
 };
 
 struct mesh_saliency {
@@ -201,20 +220,33 @@ inline point_grid make_point_grid(const std::vector<glm::dvec3>& pts, const std:
   return g;
 }
 
+inline constexpr std::size_t block_lanes = 8;  // candidates per block of the pair kernel
+
+// Rows of n doubles rounded up to a multiple of 8 (whole blocks), each 64-byte aligned when the
+// first is: aligned_offset(v) is where the first 64-byte boundary of v's storage lies.
+inline std::size_t block_stride(std::size_t n) { return (n + block_lanes - 1) / block_lanes * block_lanes; }
+inline std::size_t aligned_offset(const std::vector<double>& v) {
+  const auto misalign = reinterpret_cast<std::uintptr_t>(v.data()) % (block_lanes * sizeof(double));
+  return misalign == 0 ? 0 : (block_lanes * sizeof(double) - misalign) / sizeof(double);
+}
+
 // Points sorted into columns of an xy grid, by z (then id) inside each column, so the points of
 // one column within a z interval are one contiguous run (found by binary search).
 struct column_grid {
-  std::vector<double> x, y, z, value;     // sorted points (structure of arrays)
+  std::vector<double> rows;               // sorted points: x, y, z, value rows (see row)
+  std::size_t points = 0, stride = 0, offset = 0;
   std::vector<std::uint32_t> src;         // index of each sorted point in the source point_grid
   std::vector<std::uint32_t> col_start;   // columns + 1 offsets into the sorted points
-  std::vector<std::uint32_t> col_of;      // column of each sorted point
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
   std::uint32_t nx = 1, ny = 1;
+  // Row r (0 x, 1 y, 2 z, 3 value), 64-byte aligned (unless the grid was copied).
+  const double* row(std::size_t r) const { return rows.data() + offset + r * stride; }
 };
 
 // Builds a column_grid with columns about `width` wide (wider when needed to keep the column
-// count O(points)). O(P log P).
-inline column_grid make_column_grid(const point_grid& g, double width) {
+// count O(points)). O(P log P); the columns are sorted in parallel through exec.
+template <class E>
+column_grid make_column_grid(E& exec, const point_grid& g, double width) {
   column_grid c;
   const std::size_t P = g.x.size();
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
@@ -239,15 +271,19 @@ inline column_grid make_column_grid(const point_grid& g, double width) {
     std::vector<std::uint32_t> cursor(c.col_start.begin(), c.col_start.end() - 1);
     for (std::size_t k = 0; k < P; ++k) order[cursor[col(k)]++] = static_cast<std::uint32_t>(k);
   }
-  for (std::size_t q = 0; q + 1 < c.col_start.size(); ++q)
-    std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t a, std::uint32_t b) {
-      return g.z[a] != g.z[b] ? g.z[a] < g.z[b] : g.id[a] < g.id[b];
-    });
-  c.x.resize(P), c.y.resize(P), c.z.resize(P), c.value.resize(P), c.col_of.resize(P);
+  exec.parallel_for(c.col_start.size() - 1, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t q = b; q < e; ++q)
+      std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t x, std::uint32_t y) {
+        return g.z[x] != g.z[y] ? g.z[x] < g.z[y] : g.id[x] < g.id[y];
+      });
+  });
+  c.points = P, c.stride = block_stride(P);
+  c.rows.assign(4 * c.stride + block_lanes, 0.0);
+  c.offset = aligned_offset(c.rows);
+  double* r = c.rows.data() + c.offset;
   for (std::size_t k = 0; k < P; ++k) {
     const std::uint32_t s = order[k];
-    c.x[k] = g.x[s], c.y[k] = g.y[s], c.z[k] = g.z[s], c.value[k] = g.value[s];
-    c.col_of[k] = col(s);
+    r[k] = g.x[s], r[c.stride + k] = g.y[s], r[2 * c.stride + k] = g.z[s], r[3 * c.stride + k] = g.value[s];
   }
   c.src = std::move(order);
   return c;
@@ -272,12 +308,11 @@ inline sigma_table make_sigma_table(const std::vector<double>& sigma) {
   return t;
 }
 
-// The pair kernel works on blocks of 4 candidates ("lanes"), held in G vectors of V (G·width
-// = 4). With GCC/Clang V is a vector extension type: 2 doubles (SSE2/NEON) by default, 4 in the
-// AVX2+FMA version chosen at run time on x86-64; other compilers get a plain 4-double struct.
-// Every lane receives the same operations in the same order in each version, so the versions
-// differ only by FMA contraction (relative 1e-16 per operation).
-inline constexpr std::size_t block_lanes = 8;
+// The pair kernel works on blocks of 8 candidates ("lanes"), held in G vectors of V (G·width
+// = 8). With GCC/Clang V is a vector extension type: 2 doubles (SSE2/NEON) by default, 4 in the
+// AVX2+FMA and 8 in the AVX-512F versions chosen at run time on x86-64; other compilers get a
+// plain 4-double struct. Every lane receives the same operations in the same order in each
+// version, so the versions differ only by FMA contraction (relative 1e-16 per operation).
 inline constexpr std::size_t fallback_width = 4;
 
 struct lanes_fallback {  // 4 doubles, for compilers without vector extensions
@@ -323,9 +358,41 @@ template <class V, class M>
 INFOLERP_SALIENCY_INLINE void keep(V& out, const M& m, const V& v) {
   out = reinterpret_cast<V>(m & reinterpret_cast<M>(v));
 }
+// a = min(a, b) per lane (for finite values or +Inf).
+template <class V>
+INFOLERP_SALIENCY_INLINE void lane_min(V& a, const V& b) {
+  const auto m = b < a;
+  using M = decltype(m);
+  a = reinterpret_cast<V>((m & reinterpret_cast<M>(b)) | (~m & reinterpret_cast<M>(a)));
+}
+// The smallest lane of v, by halving (log2(width) shuffles and minima, not width − 1 scalar ones).
+template <class V>
+INFOLERP_SALIENCY_INLINE double lanes_min(const V& lanes) {
+  constexpr std::size_t width = sizeof(V) / sizeof(double);
+  V v = lanes;
+  if constexpr (width == 8) {
+    lane_min(v, __builtin_shufflevector(v, v, 4, 5, 6, 7, 0, 1, 2, 3));
+    lane_min(v, __builtin_shufflevector(v, v, 2, 3, 0, 1, 6, 7, 4, 5));
+    lane_min(v, __builtin_shufflevector(v, v, 1, 0, 3, 2, 5, 4, 7, 6));
+  } else if constexpr (width == 4) {
+    lane_min(v, __builtin_shufflevector(v, v, 2, 3, 0, 1));
+    lane_min(v, __builtin_shufflevector(v, v, 1, 0, 3, 2));
+  } else {
+    lane_min(v, __builtin_shufflevector(v, v, 1, 0));
+  }
+  return v[0];
+}
 #endif
 inline void keep(lanes_fallback& out, const mask_fallback& m, const lanes_fallback& v) {
   for (std::size_t l = 0; l < fallback_width; ++l) out.v[l] = m.v[l] ? v.v[l] : 0.0;
+}
+inline void lane_min(lanes_fallback& a, const lanes_fallback& b) {
+  for (std::size_t l = 0; l < fallback_width; ++l) a.v[l] = std::min(a.v[l], b.v[l]);
+}
+inline double lanes_min(const lanes_fallback& v) {
+  double m = v.v[0];
+  for (std::size_t l = 1; l < fallback_width; ++l) m = std::min(m, v.v[l]);
+  return m;
 }
 
 template <class V>
@@ -333,139 +400,244 @@ INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
   std::memcpy(&v, p, sizeof v);
 }
 
-// For each sorted point i in [first, last): Σ_j w_u(d)·value_j / Σ_j w_u(d) over the points j
-// within each ball (i itself included), written to avg[u * P + src[i]]. Candidates come in
-// z-runs of the columns near i, 4 lanes at a time; σ from the largest down, stopping at the
-// first ball that holds none of the 4. Each lane accumulates its own partial sums, which are
-// added in a fixed order at the end: the result depends on the data only.
 template <class V>
-INFOLERP_SALIENCY_INLINE void gather_points(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
-                          std::size_t last, double* avg) {
-  constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
-  const std::size_t L = t.r2.size(), P = g.x.size();
-  const double r2max = t.r2[L - 1];
-  for (std::size_t i = first; i < last; ++i) {
-    const double xi = g.x[i], yi = g.y[i], zi = g.z[i];
-    V acc_n[32][G] = {}, acc_d[32][G] = {}, w[32][G];
-    const std::uint32_t cx = g.col_of[i] / g.ny, cy = g.col_of[i] % g.ny;
-    const std::uint32_t ax0 = cx > span ? cx - span : 0, ax1 = std::min(cx + span, g.nx - 1);
-    const std::uint32_t ay0 = cy > span ? cy - span : 0, ay1 = std::min(cy + span, g.ny - 1);
-    for (std::uint32_t ax = ax0; ax <= ax1; ++ax)
-      for (std::uint32_t ay = ay0; ay <= ay1; ++ay) {
-        const std::uint32_t q = ax * g.ny + ay;
-        if (g.col_start[q] == g.col_start[q + 1]) continue;
-        const double lx = g.x0 + ax * g.h, ly = g.y0 + ay * g.h;
-        const double gx = std::max({0.0, lx - xi, xi - (lx + g.h)}), gy = std::max({0.0, ly - yi, yi - (ly + g.h)});
-        const double dxy2 = gx * gx + gy * gy;
-        if (dxy2 > r2max) continue;
-        const double half = std::sqrt(r2max - dxy2);
-        const double* zb = g.z.data() + g.col_start[q];
-        const double* ze = g.z.data() + g.col_start[q + 1];
-        const std::size_t j0 = static_cast<std::size_t>(std::lower_bound(zb, ze, zi - half) - g.z.data());
-        const std::size_t j1 = static_cast<std::size_t>(std::upper_bound(zb, ze, zi + half) - g.z.data());
-        for (std::size_t j = j0; j < j1; j += block_lanes) {
-          const double *xs = &g.x[j], *ys = &g.y[j], *zs = &g.z[j], *cs = &g.value[j];
-          double px[block_lanes], py[block_lanes], pz[block_lanes], pc[block_lanes];
-          if (j + block_lanes > j1) {  // tail: pad with points outside every ball
-            // At z = +Inf a pad's d² is +Inf at any scale (an absolute offset such as
-            // zi + 4·half + 1 falls inside the ball when 2σ_max > 1 mesh unit, or is absorbed
-            // by a large zi); its weight is masked off bitwise like any point outside.
-            for (std::size_t l = 0; l < block_lanes; ++l) {
-              const bool in = j + l < j1;
-              px[l] = in ? g.x[j + l] : xi, py[l] = in ? g.y[j + l] : yi;
-              pz[l] = in ? g.z[j + l] : std::numeric_limits<double>::infinity(), pc[l] = in ? g.value[j + l] : 0.0;
-            }
-            xs = px, ys = py, zs = pz, cs = pc;
-          }
-          V d2[G];
-          double dmin = std::numeric_limits<double>::infinity();
-          for (std::size_t k = 0; k < G; ++k) {
-            const std::size_t o = k * width;
-            V vx, vy, vz;
-            load_lanes(vx, xs + o), load_lanes(vy, ys + o), load_lanes(vz, zs + o);
-            const V dx = vx - xi, dy = vy - yi, dz = vz - zi;
-            d2[k] = dx * dx + dy * dy + dz * dz;
-          }
-          {
-            double d[block_lanes];
-            std::memcpy(d, d2, sizeof d);
-            for (std::size_t l = 0; l < block_lanes; ++l) dmin = std::min(dmin, d[l]);
-          }
-          for (std::size_t u = L; u-- > 0 && dmin <= t.r2[u];) {  // smaller σ have smaller balls
-            const int p = t.pow_of[u];
-            for (std::size_t k = 0; k < G; ++k) {
-              if (p >= 0) {
-                const V s2 = w[p][k] * w[p][k];
-                w[u][k] = s2 * s2;
-              } else {
-                w[u][k] = d2[k] * t.a[u];
-                exp_neg_inplace(w[u][k]);
-              }
-              V m;
-              keep(m, d2[k] <= t.r2[u], w[u][k]);
-              V c;
-              load_lanes(c, cs + k * width);
-              acc_n[u][k] = acc_n[u][k] + m * c;
-              acc_d[u][k] = acc_d[u][k] + m;
-            }
-          }
-        }
-      }
-    for (std::size_t u = 0; u < L; ++u) {
-      double n[block_lanes], d[block_lanes];
-      std::memcpy(n, acc_n[u], sizeof n);
-      std::memcpy(d, acc_d[u], sizeof d);
-      for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
-        for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
-      avg[u * P + g.src[i]] = n[0] / d[0];
-    }
-  }
+INFOLERP_SALIENCY_INLINE void store_lanes(double* p, const V& v) {
+  std::memcpy(p, &v, sizeof v);
 }
 
-inline void gather_points_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, std::size_t first,
-                                   std::size_t last, double* avg) {
-#if defined(__GNUC__) || defined(__clang__)
-  gather_points<v2d>(g, t, span, first, last, avg);
+inline constexpr double lane_numbers[block_lanes] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+// The sums of the points, by blocks of 8 sorted points: per block, per σ, 8 numerators then 8
+// denominators (one 64-byte line each), so that a block's sums for every σ are adjacent (few
+// pages per pass: the kernel is memory-bound there). Point j's numerator for σ u:
+inline double* point_sums(double* sums, std::size_t L, std::size_t j, std::size_t u) {
+  return sums + j / block_lanes * (2 * block_lanes * L) + u * 2 * block_lanes + j % block_lanes;
+}
+
+// A tile: the columns [cx0, cx1) × [cy0, cy1) of a column_grid.
+struct column_tile {
+  std::uint32_t cx0, cx1, cy0, cy1;
+  std::uint32_t points;  // in the tile
+};
+
+#if defined(__clang__)
+#define INFOLERP_SALIENCY_UNROLL _Pragma("unroll 8")
+#elif defined(__GNUC__)
+#define INFOLERP_SALIENCY_UNROLL _Pragma("GCC unroll 8")
 #else
-  gather_points<lanes_fallback>(g, t, span, first, last, avg);
+#define INFOLERP_SALIENCY_UNROLL
+#endif
+
+// Every pair once: each point i of the tile (in sorted order) meets the points j after it in
+// the sorted order (its own column above i, then the later columns within 2σ_max), 8
+// candidates j at a time, σ from the largest down, stopping at the first ball that holds none
+// of the 8. A pair's weights are added to i's sums (registers, one partial sum per lane, added
+// in a fixed order when i is done) and to j's sums (point_sums, in memory). Writes
+// reach the tile's columns and the columns up to `span` later in x and span either side in y;
+// the caller runs tiles whose write sets are disjoint concurrently, in a fixed order otherwise.
+// LC >= the number of σ: the σ loop is unrolled (8 at a time) so that, with LC = 8, i's sums
+// stay in registers (AVX-512: 16 of its 32).
+template <class V, std::size_t LC>
+INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
+                                          column_tile tile, double* sums) {
+  constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
+  const std::size_t L = t.r2.size();
+  const double r2max = t.r2[L - 1];
+  const double *px_all = g.row(0), *py_all = g.row(1), *pz_all = g.row(2), *pc_all = g.row(3);
+  for (std::uint32_t cx = tile.cx0; cx < tile.cx1; ++cx)
+    for (std::uint32_t cy = tile.cy0; cy < tile.cy1; ++cy)
+      for (std::size_t i = g.col_start[cx * g.ny + cy]; i < g.col_start[cx * g.ny + cy + 1]; ++i) {
+        const double xi = px_all[i], yi = py_all[i], zi = pz_all[i], ci = pc_all[i];
+        V acc_n[LC][G] = {}, acc_d[LC][G] = {}, w[LC][G];  // index s: σ number L − 1 − s
+        for (std::uint32_t ax = cx; ax <= std::min(cx + span, g.nx - 1); ++ax)
+          for (std::uint32_t ay = ax == cx ? cy : (cy > span ? cy - span : 0); ay <= std::min(cy + span, g.ny - 1); ++ay) {
+            const std::uint32_t q = ax * g.ny + ay;
+            if (g.col_start[q] == g.col_start[q + 1]) continue;
+            const double lx = g.x0 + ax * g.h, ly = g.y0 + ay * g.h;
+            const double gx = std::max({0.0, lx - xi, xi - (lx + g.h)}), gy = std::max({0.0, ly - yi, yi - (ly + g.h)});
+            const double dxy2 = gx * gx + gy * gy;
+            if (dxy2 > r2max) continue;
+            const double half = std::sqrt(r2max - dxy2);
+            const double* zb = pz_all + g.col_start[q];
+            const double* ze = pz_all + g.col_start[q + 1];
+            const std::size_t j1 = static_cast<std::size_t>(std::upper_bound(zb, ze, zi + half) - pz_all);
+            const std::size_t j0 = ax == cx && ay == cy ? i + 1  // own column: the points above i
+                                   : static_cast<std::size_t>(std::lower_bound(zb, ze, zi - half) - pz_all);
+            // Blocks start at multiples of 8, so that j's sums are whole aligned vectors.
+            for (std::size_t j = j0 / block_lanes * block_lanes; j < j1; j += block_lanes) {
+              const bool partial = j < j0 || j + block_lanes > j1;
+              V d2[G], c[G];
+              for (std::size_t k = 0; k < G; ++k) {
+                const std::size_t o = j + k * width;
+                V vx, vy, vz;
+                load_lanes(vx, px_all + o), load_lanes(vy, py_all + o), load_lanes(vz, pz_all + o), load_lanes(c[k], pc_all + o);
+                const V dx = vx - xi, dy = vy - yi, dz = vz - zi;
+                d2[k] = dx * dx + dy * dy + dz * dz;
+                if (partial) {  // lanes outside [j0, j1) (other points, or the rows' padding) get d² = +Inf
+                  V lane;
+                  load_lanes(lane, lane_numbers + k * width);
+                  const V after_j0 = lane + (static_cast<double>(j) - static_cast<double>(j0) + 0.5);
+                  const V before_j1 = lane * -1.0 + (static_cast<double>(j1) - static_cast<double>(j) - 0.5);
+                  V pad;
+                  keep(pad, after_j0 * before_j1 <= 0.0, lane * 0.0 + std::numeric_limits<double>::infinity());
+                  d2[k] = d2[k] + pad;
+                }
+              }
+              V nearest = d2[0];
+              for (std::size_t k = 1; k < G; ++k) lane_min(nearest, d2[k]);
+              const double dmin = lanes_min(nearest);
+              INFOLERP_SALIENCY_UNROLL
+              for (std::size_t s = 0; s < LC; ++s) {
+                if (s == L || !(dmin <= t.r2[L - 1 - s])) break;  // smaller σ have smaller balls
+                const std::size_t u = L - 1 - s;
+                const int p = t.pow_of[u];
+                V mn[G], md[G];
+                for (std::size_t k = 0; k < G; ++k) {
+                  if (p >= 0) {
+                    const V& wp = w[L - 1 - static_cast<std::size_t>(p)][k];
+                    const V s2 = wp * wp;
+                    w[s][k] = s2 * s2;
+                  } else {
+                    w[s][k] = d2[k] * t.a[u];
+                    exp_neg_inplace(w[s][k]);
+                  }
+                  V m;
+                  keep(m, d2[k] <= t.r2[u], w[s][k]);
+                  acc_n[s][k] = acc_n[s][k] + m * c[k];
+                  acc_d[s][k] = acc_d[s][k] + m;
+                  md[k] = m, mn[k] = m * ci;
+                }
+                double* nj = point_sums(sums, L, j, u);
+                double* dj = nj + block_lanes;
+                if (!partial) {
+                  for (std::size_t k = 0; k < G; ++k) {
+                    V a, b;
+                    load_lanes(a, nj + k * width), load_lanes(b, dj + k * width);
+                    a = a + mn[k], b = b + md[k];
+                    store_lanes(nj + k * width, a), store_lanes(dj + k * width, b);
+                  }
+                } else {  // only the real lanes: the rest belong to other points
+                  double n[block_lanes], d[block_lanes];
+                  std::memcpy(n, mn, sizeof n);
+                  std::memcpy(d, md, sizeof d);
+                  for (std::size_t l = j0 > j ? j0 - j : 0; j + l < j1 && l < block_lanes; ++l) nj[l] += n[l], dj[l] += d[l];
+                }
+              }
+            }
+          }
+        for (std::size_t s = 0; s < L; ++s) {
+          double n[block_lanes], d[block_lanes];
+          std::memcpy(n, acc_n[s], sizeof n);
+          std::memcpy(d, acc_d[s], sizeof d);
+          for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
+            for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
+          double* ni = point_sums(sums, L, i, L - 1 - s);
+          ni[0] += n[0] + ci;  // i itself: weight 1
+          ni[block_lanes] += d[0] + 1.0;
+        }
+      }
+}
+
+// One tile with vectors V, 8 or 32 σ slots.
+template <class V>
+INFOLERP_SALIENCY_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
+                                              column_tile tile, double* sums) {
+  if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, sums);
+  gather_tile<V, 32>(g, t, span, tile, sums);
+}
+
+inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, column_tile tile,
+                                 double* sums) {
+#if defined(__GNUC__) || defined(__clang__)
+  gather_tile_any<v2d>(g, t, span, tile, sums);
+#else
+  gather_tile_any<lanes_fallback>(g, t, span, tile, sums);
 #endif
 }
 
-// Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel.
+// Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel, INFOLERP_NO_AVX512 to
+// use AVX2 at most.
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
-#define INFOLERP_SALIENCY_AVX2 1
-__attribute__((target("avx2,fma"))) inline void gather_points_avx2(const column_grid& g, const sigma_table& t,
-                                                                   std::uint32_t span, std::size_t first,
-                                                                   std::size_t last, double* avg) {
-  gather_points<v4d>(g, t, span, first, last, avg);
+#define INFOLERP_SALIENCY_X86 1
+using v8d = double __attribute__((vector_size(64)));
+__attribute__((target("avx2,fma"))) inline void gather_tile_avx2(const column_grid& g, const sigma_table& t,
+                                                                 std::uint32_t span, column_tile tile, double* sums) {
+  gather_tile_any<v4d>(g, t, span, tile, sums);
 }
-inline bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+__attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const column_grid& g, const sigma_table& t,
+                                                                           std::uint32_t span, column_tile tile,
+                                                                           double* sums) {
+  gather_tile_any<v8d>(g, t, span, tile, sums);
+}
+// 2: AVX-512F, 1: AVX2 and FMA, 0: neither.
+inline int x86_vector_level() {
+#ifndef INFOLERP_NO_AVX512
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma")) return 2;
+#endif
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? 1 : 0;
+}
 #endif
 #if defined(__GNUC__) || defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
 
 // Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
-// points. Returns avg[u * P + k] for point k of g. Each point gathers its own sums (every pair
-// is evaluated from both ends), so points are independent: parallel with no write conflicts,
-// identical bits for any executor and thread count.
+// points. Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
+// tiles of span × span columns in 6 phases by (tile x mod 2, tile y mod 3): the tiles of one
+// phase write disjoint points, so they run in parallel, and every point receives its terms in
+// an order fixed by the data: identical bits for any executor, thread count and grain (tiles
+// per task).
 template <class E>
 std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const std::vector<double>& sigma,
                                             std::size_t grain) {
   const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
-  const column_grid g = make_column_grid(pg, rmax / 3.0);
+  const column_grid g = make_column_grid(exec, pg, rmax / 3.0);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
+  const std::size_t stride = g.stride;
+  std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
+  double* sums = storage.data() + aligned_offset(storage);
+#ifdef INFOLERP_SALIENCY_X86
+  const int level = x86_vector_level();
+#endif
+  // Tiles of span × span columns: a tile writes its own columns and those up to span later in x,
+  // span either side in y, so tiles 2 apart in x or 3 apart in y never write the same point.
+  const std::uint32_t ntx = (g.nx + span - 1) / span, nty = (g.ny + span - 1) / span;
+  std::vector<column_tile> tiles;
+  for (std::uint32_t phase = 0; phase < 6; ++phase) {
+    tiles.clear();
+    for (std::uint32_t tx = phase / 3; tx < ntx; tx += 2)
+      for (std::uint32_t ty = phase % 3; ty < nty; ty += 3) {
+        column_tile c{tx * span, std::min((tx + 1) * span, g.nx), ty * span, std::min((ty + 1) * span, g.ny), 0};
+        for (std::uint32_t x = c.cx0; x < c.cx1; ++x) c.points += g.col_start[x * g.ny + c.cy1] - g.col_start[x * g.ny + c.cy0];
+        if (c.points) tiles.push_back(c);
+      }
+    // Largest first balances the workers; the order within a phase does not change any result.
+    std::stable_sort(tiles.begin(), tiles.end(), [](const column_tile& a, const column_tile& b) { return a.points > b.points; });
+    exec.parallel_for(tiles.size(), std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+#ifdef INFOLERP_SALIENCY_X86
+        if (level == 2) {
+          gather_tile_avx512(g, t, span, tiles[k], sums);
+          continue;
+        }
+        if (level == 1) {
+          gather_tile_avx2(g, t, span, tiles[k], sums);
+          continue;
+        }
+#endif
+        gather_tile_portable(g, t, span, tiles[k], sums);
+      }
+    });
+  }
   std::vector<double> avg(L * P);
-#ifdef INFOLERP_SALIENCY_AVX2
-  const bool avx2 = cpu_has_avx2_fma();
-#endif
-  exec.parallel_for(P, 64 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-#ifdef INFOLERP_SALIENCY_AVX2
-    if (avx2) return gather_points_avx2(g, t, span, b, e, avg.data());
-#endif
-    gather_points_portable(g, t, span, b, e, avg.data());
+  exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t u = b; u < e; ++u)
+      for (std::size_t k = 0; k < P; ++k) {
+        const double* nk = point_sums(sums, L, k, u);
+        avg[u * P + g.src[k]] = nk[0] / nk[block_lanes];
+      }
   });
   return avg;
 }
@@ -562,11 +734,11 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 // scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5, a σ whose square is not a
 // normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a
 // mesh whose bounding box has zero diagonal (degenerate_triangle).
-// Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the pairs
-// within 2σ_max, each counted from both ends); approximate: O(V·σs·k) with
-// k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (16 doubles per
-// vertex and distinct σ at most; never per pair). Parallel through exec; the result is
-// identical for every executor and thread count.
+// Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
+// unordered pairs within 2σ_max, each evaluated once); approximate: O(V·σs·k) with
+// k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (3 doubles per
+// vertex and distinct σ, 64 at most; never per pair). Parallel through exec (exact: 6 phases of
+// tiles); the result is identical for every executor and thread count.
 template <class M, class E = serial_executor>
 result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt = {}, E&& exec = E{}) {
   static_assert(check_mesh<M>());
