@@ -18,7 +18,8 @@
 //   ibuffer_linear    the same with the paper's screen-linear weights (inv_depth = 1)
 //   ibuffer_probe     the I-Buffer with probes: the primary hit (and the sun ray, "+sun") at every
 //                     pixel, AO and soft shadow interpolated from the sources matching the new
-//                     sample's own cluster id (min_sources 1 or 2)
+//                     sample's own cluster id (min_sources 1 or 2); "sun where needed": probes of the
+//                     primary ray only, refined with the sun ray where two agreeing sources do not suffice
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
@@ -229,6 +230,28 @@ class harness {
               if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
             }
       }
+      // Cheap probes (primary ray only) refined with the sun ray where two agreeing sources do not suffice.
+      sup::shader_options po = shading_;
+      po.ao_rays = 0;
+      po.soft_shadow_rays = 0;
+      const sup::reference_shader primary_sun(scene_, po);
+      po.hard_shadow = false;
+      const sup::reference_shader primary(scene_, po);
+      std::vector<const sup::scene_clustering*> with{&features};
+      for (const auto& c : coarser) with.push_back(&c);
+      for (const sup::scene_clustering* c : with)
+        for (std::uint32_t passes = 4; passes <= 6; ++passes) {
+          sup::demo_refining_probe_source src;
+          static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+          src.primary = &primary;
+          src.probe_lights = false;
+          src.primary_sun = &primary_sun;
+          double f = 0;
+          char setting[128];
+          std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min 1 src, %u passes", c->name.c_str(),
+                        c->count(), passes);
+          if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, 1)) return 1;
+        }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {
@@ -439,7 +462,7 @@ class harness {
     if (!matches(setting)) return true;
     auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
                                                   {.passes = passes, .max_passes = passes, .rows_per_task = 2,
-                                                   .min_sources = min_sources});
+                                                   .record_kinds = false, .min_sources = min_sources});
     if (!up) return fail(up.error().message()) == 0;
     sup::image img(w_, h_);
     stopwatch t;

@@ -377,11 +377,12 @@ class upsampler {
   }
 
   // Later passes with probes: R as above; every new sample probes its own pixel and is
-  // interpolated from the sources compatible with its probe. Edge: both sources, or one when
-  // min_sources is 1. Centre, by the compatible corners: all four (weights 1/4); three, the
-  // diagonal opposite the missing corner (the centre is its midpoint, so a plane through the
-  // three corners is reproduced exactly); two, that pair; one, that corner when min_sources is
-  // 1. Otherwise evaluated.
+  // interpolated from the sources compatible with its probe (complete_probe). A source that
+  // can refine its probes (refine_probe, sample_source.hpp) probes cheaply first and needs
+  // sources that agree with each other and bracket the new sample (both of an edge; all four
+  // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
+  // leaves out is taken from sources on both sides of it; only where that fails is the probe
+  // refined and tested again, now with compatible() and min_sources. Otherwise evaluated.
   template <class S, class Pixel>
   void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
                  std::array<std::size_t, 3>& counts) {
@@ -391,63 +392,91 @@ class upsampler {
     // Sources that match the probe match each other (compatible() is an equivalence), unless
     // the probe is tested with a probe_compatible() that leaves something out.
     constexpr bool cross_check = detail::member_probe_compatible<S> || detail::adl_probe_compatible<Sample>;
+    const auto probe_match = [&](const Sample& p, const Sample& s) { return detail::may_complete(src, p, s); };
     const Sample* prev = levels_[d + 1].data();
     const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;
     const Sample* r1 = (j & 1u) ? r0 + pw : r0;
+    Sample s;
     for (std::uint32_t i = 0; i < w; ++i) {
-      const std::uint32_t a = i / 2;
       if ((j & 1u) == 0 && (i & 1u) == 0) {
-        store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
+        store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
         continue;
       }
       const std::uint32_t x = i << d, y = j << d;
       Sample p = src.probe(x, y);
-      const bool centre = (i & 1u) && (j & 1u);
-      if (!centre) {
-        const Sample& s0 = r0[a];
-        const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
-        const bool m0 = detail::may_complete(src, p, s0), m1 = detail::may_complete(src, p, s1);
-        if (m0 && m1 && (!cross_check || detail::may_interpolate(src, s0, s1))) {
-          store(src, d, i, j, detail::source_interpolate(src, p, s0, s1), sample_kind::interpolated, out, counts);
-        } else if (single && (m0 || m1)) {
-          const Sample& s = m0 ? s0 : s1;
-          store(src, d, i, j, detail::source_interpolate(src, p, s, s), sample_kind::interpolated, out, counts);
-        } else {
-          store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+      if constexpr (refining_sample_source<S>) {
+        if (!complete_probe(src, p, r0, r1, i, j, false, cross_check, true, probe_match, s)) {
+          p = src.refine_probe(p, x, y);
+          const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
+          if (!complete_probe(src, p, r0, r1, i, j, single, false, false, full_match, s)) {
+            store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+            continue;
+          }
         }
+      } else if (!complete_probe(src, p, r0, r1, i, j, single, cross_check, false, probe_match, s)) {
+        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
         continue;
       }
-      const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
-      unsigned mask = 0;
-      for (unsigned k = 0; k < 4; ++k) mask |= detail::may_complete(src, p, *c[k]) ? 1u << k : 0u;
-      if (cross_check && mask == 0xF &&
-          !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
-            detail::may_interpolate(src, *c[0], *c[3])))
-        mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out): evaluate
-      const Sample* s0 = nullptr;
-      const Sample* s1 = nullptr;
-      switch (mask) {
-        case 0xF:
-          store(src, d, i, j, detail::source_interpolate(src, p, *c[0], *c[1], *c[2], *c[3]), sample_kind::interpolated,
-                out, counts);
-          continue;
-        case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
-        case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
-        case 0x3: s0 = c[0]; s1 = c[1]; break;                      // adjacent pairs
-        case 0xC: s0 = c[2]; s1 = c[3]; break;
-        case 0x5: s0 = c[0]; s1 = c[2]; break;
-        case 0xA: s0 = c[1]; s1 = c[3]; break;
-        case 0x1: case 0x2: case 0x4: case 0x8:
-          if (single) s0 = s1 = c[mask == 0x1 ? 0 : mask == 0x2 ? 1 : mask == 0x4 ? 2 : 3];
-          break;
-        default: break;
-      }
-      if (s0 != nullptr && (!cross_check || detail::may_interpolate(src, *s0, *s1))) {
-        store(src, d, i, j, detail::source_interpolate(src, p, *s0, *s1), sample_kind::interpolated, out, counts);
-      } else {
-        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
-      }
+      store(src, d, i, j, std::move(s), sample_kind::interpolated, out, counts);
     }
+  }
+
+  // Interpolates probe p of the new sample (i, j) into `s` from the previous-pass sources
+  // (rows r0 and r1) that match(p, source) accepts; false, s untouched, when too few match.
+  // Edge: both sources, or one when `single`. Centre, by the matching corners: all four
+  // (weights 1/4); three, the diagonal opposite the missing corner (the centre is its midpoint,
+  // so a plane through the three corners is reproduced exactly); two, that pair; one, that
+  // corner when `single`. With `cross`, the chosen sources must also be compatible() with
+  // each other; with `bracket`, an adjacent pair of corners (the centre is not between them)
+  // does not suffice.
+  template <class S, class M>
+  static bool complete_probe(const S& src, const Sample& p, const Sample* r0, const Sample* r1, std::uint32_t i,
+                             std::uint32_t j, bool single, bool cross, bool bracket, const M& match, Sample& s) {
+    const std::uint32_t a = i / 2;
+    if (!((i & 1u) && (j & 1u))) {  // edge
+      const Sample& s0 = r0[a];
+      const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
+      const bool m0 = match(p, s0), m1 = match(p, s1);
+      if (m0 && m1 && (!cross || detail::may_interpolate(src, s0, s1))) {
+        s = detail::source_interpolate(src, p, s0, s1);
+        return true;
+      }
+      if (single && (m0 || m1)) {
+        const Sample& t = m0 ? s0 : s1;
+        s = detail::source_interpolate(src, p, t, t);
+        return true;
+      }
+      return false;
+    }
+    const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
+    unsigned mask = 0;
+    for (unsigned k = 0; k < 4; ++k) mask |= match(p, *c[k]) ? 1u << k : 0u;
+    if (cross && mask == 0xF &&
+        !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
+          detail::may_interpolate(src, *c[0], *c[3])))
+      mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out)
+    const Sample* s0 = nullptr;
+    const Sample* s1 = nullptr;
+    switch (mask) {
+      case 0xF:
+        s = detail::source_interpolate(src, p, *c[0], *c[1], *c[2], *c[3]);
+        return true;
+      case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
+      case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
+      case 0x3: case 0xC: case 0x5: case 0xA:  // adjacent pairs
+        if (!bracket) {
+          s0 = c[mask == 0xC ? 2 : mask == 0xA ? 1 : 0];
+          s1 = c[mask == 0x3 ? 1 : mask == 0x5 ? 2 : 3];
+        }
+        break;
+      case 0x1: case 0x2: case 0x4: case 0x8:
+        if (single) s0 = s1 = c[mask == 0x1 ? 0 : mask == 0x2 ? 1 : mask == 0x4 ? 2 : 3];
+        break;
+      default: break;
+    }
+    if (s0 == nullptr || (cross && !detail::may_interpolate(src, *s0, *s1))) return false;
+    s = detail::source_interpolate(src, p, *s0, *s1);
+    return true;
   }
 
   upsampler_options options_{};
