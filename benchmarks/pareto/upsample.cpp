@@ -239,19 +239,21 @@ class harness {
       const sup::reference_shader primary(scene_, po);
       std::vector<const sup::scene_clustering*> with{&features};
       for (const auto& c : coarser) with.push_back(&c);
+      // The demo clustering with 2-6 passes (min_sources 1) and 2-4 (min_sources 2), the coarser ones with 4-6.
       for (const sup::scene_clustering* c : with)
-        for (std::uint32_t passes = 4; passes <= 6; ++passes) {
-          sup::demo_refining_probe_source src;
-          static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
-          src.primary = &primary;
-          src.probe_lights = false;
-          src.primary_sun = &primary_sun;
-          double f = 0;
-          char setting[128];
-          std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min 1 src, %u passes", c->name.c_str(),
-                        c->count(), passes);
-          if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, 1)) return 1;
-        }
+        for (std::uint32_t min_sources = 1; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
+          for (std::uint32_t passes = c == &features ? 2 : 4; passes <= (min_sources == 1 ? 6u : 4u); ++passes) {
+            sup::demo_refining_probe_source src;
+            static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+            src.primary = &primary;
+            src.probe_lights = false;
+            src.primary_sun = &primary_sun;
+            double f = 0;
+            char setting[128];
+            std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min %u src, %u passes", c->name.c_str(),
+                          c->count(), min_sources, passes);
+            if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+          }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {
