@@ -46,9 +46,10 @@
 //   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const
 //        the probe with what it left out added (e.g. the hard-shadow rays), so that compatible()
 //        holds between it and a source exactly when it would for the full evaluation
-// and then probes stay cheap: the upsampler refines a probe only where two sources that agree
-// with each other do not suffice (upsampler.hpp), and the sun ray of every other pixel is
-// saved (demo scene, 1025²: about 85% of the sun rays, see upsampler.hpp).
+// and then probes stay cheap: the upsampler refines a probe only where sources that agree
+// with each other and bracket the new sample do not suffice (upsampler.hpp). On the demo
+// scene (1025², 4 passes) 2.8% of the probes are refined with 518 ids, 2.0% with 159, so about
+// 97% of the probes trace no sun ray.
 #include <array>
 #include <concepts>
 #include <cstddef>

@@ -23,6 +23,9 @@
 // shadows) from the previous-pass sources that match its probe (see probe_row for which);
 // with no match it is evaluated. Cost: one probe per new sample (each pixel is probed once:
 // R samples keep their probe), so a probe must be much cheaper than an evaluation to pay off.
+// Cheaper still, a source may probe only the primary ray and refine a probe with the
+// hard-shadow rays where the sources that agree with each other and bracket the new sample do
+// not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
 // sun, 2 threads, process CPU time, least of 3 runs; full per-pixel evaluation 3.23 s):
@@ -377,7 +380,7 @@ class upsampler {
   }
 
   // Later passes with probes: R as above; every new sample probes its own pixel and is
-  // interpolated from the sources compatible with its probe (complete_probe). A source that
+  // interpolated from the sources compatible with its probe (choose_sources). A source that
   // can refine its probes (refine_probe, sample_source.hpp) probes cheaply first and needs
   // sources that agree with each other and bracket the new sample (both of an edge; all four
   // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
@@ -396,7 +399,6 @@ class upsampler {
     const Sample* prev = levels_[d + 1].data();
     const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;
     const Sample* r1 = (j & 1u) ? r0 + pw : r0;
-    Sample s;
     for (std::uint32_t i = 0; i < w; ++i) {
       if ((j & 1u) == 0 && (i & 1u) == 0) {
         store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
@@ -404,63 +406,67 @@ class upsampler {
       }
       const std::uint32_t x = i << d, y = j << d;
       Sample p = src.probe(x, y);
+      chosen k;
       if constexpr (refining_sample_source<S>) {
-        if (!complete_probe(src, p, r0, r1, i, j, false, cross_check, true, probe_match, s)) {
+        k = choose_sources(src, p, r0, r1, i, j, false, cross_check, true, probe_match);
+        if (k.n == 0) {
           p = src.refine_probe(p, x, y);
           const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
-          if (!complete_probe(src, p, r0, r1, i, j, single, false, false, full_match, s)) {
-            store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
-            continue;
-          }
+          k = choose_sources(src, p, r0, r1, i, j, single, false, false, full_match);
         }
-      } else if (!complete_probe(src, p, r0, r1, i, j, single, cross_check, false, probe_match, s)) {
-        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
-        continue;
+      } else {
+        k = choose_sources(src, p, r0, r1, i, j, single, cross_check, false, probe_match);
       }
-      store(src, d, i, j, std::move(s), sample_kind::interpolated, out, counts);
+      if (k.n == 0) {
+        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+      } else if (k.n == 4) {
+        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
+              sample_kind::interpolated, out, counts);
+      } else {
+        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1]), sample_kind::interpolated, out,
+              counts);
+      }
     }
   }
 
-  // Interpolates probe p of the new sample (i, j) into `s` from the previous-pass sources
-  // (rows r0 and r1) that match(p, source) accepts; false, s untouched, when too few match.
-  // Edge: both sources, or one when `single`. Centre, by the matching corners: all four
-  // (weights 1/4); three, the diagonal opposite the missing corner (the centre is its midpoint,
-  // so a plane through the three corners is reproduced exactly); two, that pair; one, that
-  // corner when `single`. With `cross`, the chosen sources must also be compatible() with
-  // each other; with `bracket`, an adjacent pair of corners (the centre is not between them)
-  // does not suffice.
+  // The previous-pass sources that complete probe p: all four corners (n = 4), two sources or
+  // one twice (n = 2), or none (n = 0).
+  struct chosen {
+    std::array<const Sample*, 4> c{};
+    unsigned n = 0;
+  };
+
+  // Chooses the sources of probe p of the new sample (i, j) among the previous-pass samples
+  // (rows r0 and r1) that match(p, source) accepts. Edge: both sources, or one when `single`.
+  // Centre, by the matching corners: all four (weights 1/4); three, the diagonal opposite the
+  // missing corner (the centre is its midpoint, so a plane through the three corners is
+  // reproduced exactly); two, that pair; one, that corner when `single`. With `cross`, the
+  // chosen sources must also be compatible() with each other; with `bracket`, an adjacent pair
+  // of corners (the centre is not between them) does not suffice.
   template <class S, class M>
-  static bool complete_probe(const S& src, const Sample& p, const Sample* r0, const Sample* r1, std::uint32_t i,
-                             std::uint32_t j, bool single, bool cross, bool bracket, const M& match, Sample& s) {
+  static chosen choose_sources(const S& src, const Sample& p, const Sample* r0, const Sample* r1, std::uint32_t i,
+                               std::uint32_t j, bool single, bool cross, bool bracket, const M& match) {
     const std::uint32_t a = i / 2;
     if (!((i & 1u) && (j & 1u))) {  // edge
-      const Sample& s0 = r0[a];
-      const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
-      const bool m0 = match(p, s0), m1 = match(p, s1);
-      if (m0 && m1 && (!cross || detail::may_interpolate(src, s0, s1))) {
-        s = detail::source_interpolate(src, p, s0, s1);
-        return true;
-      }
-      if (single && (m0 || m1)) {
-        const Sample& t = m0 ? s0 : s1;
-        s = detail::source_interpolate(src, p, t, t);
-        return true;
-      }
-      return false;
+      const Sample* s0 = &r0[a];
+      const Sample* s1 = (j & 1u) ? &r1[a] : &r0[a + 1];
+      const bool m0 = match(p, *s0), m1 = match(p, *s1);
+      if (m0 && m1 && (!cross || detail::may_interpolate(src, *s0, *s1))) return {{s0, s1}, 2};
+      if (single && (m0 || m1)) return {{m0 ? s0 : s1, m0 ? s0 : s1}, 2};
+      return {};
     }
-    const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
+    const std::array<const Sample*, 4> c = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
     unsigned mask = 0;
     for (unsigned k = 0; k < 4; ++k) mask |= match(p, *c[k]) ? 1u << k : 0u;
-    if (cross && mask == 0xF &&
-        !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
-          detail::may_interpolate(src, *c[0], *c[3])))
-      mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out)
+    if (mask == 0xF) {
+      if (!cross || (detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
+                     detail::may_interpolate(src, *c[0], *c[3])))
+        return {c, 4};
+      return {};  // the four disagree among themselves (e.g. light bits the probe leaves out)
+    }
     const Sample* s0 = nullptr;
     const Sample* s1 = nullptr;
     switch (mask) {
-      case 0xF:
-        s = detail::source_interpolate(src, p, *c[0], *c[1], *c[2], *c[3]);
-        return true;
       case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
       case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
       case 0x3: case 0xC: case 0x5: case 0xA:  // adjacent pairs
@@ -474,9 +480,8 @@ class upsampler {
         break;
       default: break;
     }
-    if (s0 == nullptr || (cross && !detail::may_interpolate(src, *s0, *s1))) return false;
-    s = detail::source_interpolate(src, p, *s0, *s1);
-    return true;
+    if (s0 == nullptr || (cross && !detail::may_interpolate(src, *s0, *s1))) return {};
+    return {{s0, s1}, 2};
   }
 
   upsampler_options options_{};
