@@ -28,14 +28,21 @@
 // not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// sun, 2 threads, process CPU time, least of 3 runs; full per-pixel evaluation 3.23 s):
-//   plain, demo thresholds (518 ids):     4 passes 8.4x 45.7 dB, 5 passes 9.0x 44.0 dB
-//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 12.9x 40.5 dB
-//   probes, 518 ids, min_sources 1:       4 passes 10.4x 54.3 dB, 5 passes 11.7x 50.4 dB
-//   probes, 131 ids, min_sources 1:       5 passes 12.8x 49.0 dB, 6 passes 13.4x 44.7 dB
+// sun, 2 threads, process CPU time, least of 3 runs, load average 4-5.5; full per-pixel
+// evaluation 3.24 s):
+//   plain, demo thresholds (518 ids):     4 passes 8.8x 45.7 dB, 5 passes 9.5x 44.0 dB
+//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 13.0x 40.5 dB
+//   probes (primary + sun), 518 ids:      4 passes 10.4x 54.3 dB, 5 passes 12.5x 50.4 dB
+//   probes (primary + sun), 131 ids:      5 passes 13.0x 49.0 dB, 6 passes 13.5x 44.7 dB
+//   refined probes (primary, sun where needed), min_sources 1:
+//     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 7.9x 56.8 dB, 4 passes 11.6x 53.9 dB, 5 passes 13.9x 49.7 dB
+//     159 ids: 4 passes 12.9x 53.1 dB, 5 passes 15.0x 48.8 dB, 6 passes 15.5x 45.0 dB
+//   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.1x 59.5 dB,
+//     1/4 7.5x 56.0 dB, 1/8 12.0x 53.0 dB, 1/16 14.0x 48.4 dB; the refined probes beat each
+//     of these with less CPU time (5-7% less) and a higher PSNR.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
-// BM_UpsampleInterpolatedPixel) is 9–15 ns per interpolated pixel, 19 ns with probes (the
-// probe included).
+// BM_UpsampleInterpolatedPixel) is 9–14 ns per interpolated pixel, 19 ns with probes, 22 ns
+// with refined probes (the probes included).
 //
 // Determinism: each output row of a pass depends only on the previous pass, so rows run in
 // parallel through the user's executor and the output is identical for any executor and thread
@@ -218,7 +225,8 @@ class upsampler {
   // out[i] = src.shade(sample, x, y) for the final I-Buffer sample of each pixel.
   // Preconditions: out.size() == width·height (else errc::bad_size, nothing written).
   // Complexity: E·(cost of evaluate) + W·H·(cost of interpolate + shade) over the executor,
-  // plus about W·H·(cost of probe) for sources with probes;
+  // plus about W·H·(cost of probe) for sources with probes (and refine_probe for the few probes
+  // that need it);
   // E ≈ (W·H)/4^(passes−1) + (cluster and shadow boundary samples). Allocation: none.
   // Thread-safety: src's const members are called concurrently (see sample_source.hpp).
   // Output is bit-identical for every executor and thread count.
