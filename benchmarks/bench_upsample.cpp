@@ -1,7 +1,8 @@
 // Cost of the I-Buffer upsampler's own work (issue 6): interpolation, re-use, compatibility tests,
 // shading into the frame buffer, with a cheap synthetic sample source so that evaluation costs
 // almost nothing. Goal: at most 20 ns per interpolated pixel on one core. The cheap_probe_source
-// rows add a probe per new sample (as cheap as the evaluation here).
+// rows add a probe per new sample (as cheap as the evaluation here); cheap_refining_source's
+// probes leave out the light bits and are refined where needed (refine_probe).
 //   ns_per_interpolated = frame time / interpolated samples (all passes; conservative: the frame
 //                         time also pays for the few evaluated and the re-used samples)
 //   ns_per_pixel        = frame time / output pixels
@@ -42,6 +43,28 @@ struct cheap_probe_source : cheap_source {
   sample probe(std::uint32_t x, std::uint32_t y) const { return evaluate(x, y); }
 };
 
+// Probes that leave out the light bits, refined (refine_probe) where two agreeing sources that
+// bracket the new sample do not suffice.
+struct cheap_refining_source : cheap_source {
+  sample probe(std::uint32_t x, std::uint32_t y) const {
+    sample s = evaluate(x, y);
+    s.lights = 0;
+    return s;
+  }
+  bool probe_compatible(const sample& p, const sample& s) const { return p.cluster == s.cluster; }
+  sample interpolate(const sample& p, const sample& a, const sample& b) const {
+    sample s = infolerp::interpolate(p, a, b);
+    s.lights = a.lights;
+    return s;
+  }
+  sample interpolate(const sample& p, const sample& a, const sample& b, const sample& c, const sample& d) const {
+    sample s = infolerp::interpolate(p, a, b, c, d);
+    s.lights = a.lights;
+    return s;
+  }
+  sample refine_probe(const sample&, std::uint32_t x, std::uint32_t y) const { return evaluate(x, y); }
+};
+
 template <class Source>
 void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
   const auto passes = static_cast<std::uint32_t>(state.range(0));
@@ -70,6 +93,7 @@ void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
 }
 BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_source)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_probe_source)->Arg(4)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_refining_source)->Arg(4)->Unit(benchmark::kMillisecond);
 
 // Plain per-pixel evaluation of the same cheap source (passes = 1), for comparison.
 void BM_UpsamplePlainEvaluation(benchmark::State& state) {

@@ -1,4 +1,4 @@
-// infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--repeat N]
+// infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N]
 //                          [--size W H] [--threads N] [--ao N] [--soft N]
 //
 // Time against error of the I-Buffer upsampler (issue 6) and its competitors on the demo scene
@@ -18,11 +18,13 @@
 //   ibuffer_linear    the same with the paper's screen-linear weights (inv_depth = 1)
 //   ibuffer_probe     the I-Buffer with probes: the primary hit (and the sun ray, "+sun") at every
 //                     pixel, AO and soft shadow interpolated from the sources matching the new
-//                     sample's own cluster id (min_sources 1 or 2)
+//                     sample's own cluster id (min_sources 1 or 2); "sun where needed": probes of the
+//                     primary ray only, refined with the sun ray where two agreeing sources do not suffice
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
-// subset (the reference always runs). --diagnose prints where the I-Buffer's error and time go
+// subset (the reference always runs), --match only the upsampler and joint-bilateral rows whose
+// setting contains TEXT (or one of TEXT|TEXT...). --diagnose prints where the I-Buffer's error and time go
 // (feature clusters, 3 and 4 passes) instead of writing a CSV.
 // Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,
 // cpu_seconds,cpu_speedup_vs_full_single: wall and process CPU time, each the least of N runs)
@@ -228,6 +230,30 @@ class harness {
               if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
             }
       }
+      // Cheap probes (primary ray only) refined with the sun ray where two agreeing sources do not suffice.
+      sup::shader_options po = shading_;
+      po.ao_rays = 0;
+      po.soft_shadow_rays = 0;
+      const sup::reference_shader primary_sun(scene_, po);
+      po.hard_shadow = false;
+      const sup::reference_shader primary(scene_, po);
+      std::vector<const sup::scene_clustering*> with{&features};
+      for (const auto& c : coarser) with.push_back(&c);
+      // The demo clustering with 2-6 passes (min_sources 1) and 2-4 (min_sources 2), the coarser ones with 4-6.
+      for (const sup::scene_clustering* c : with)
+        for (std::uint32_t min_sources = 1; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
+          for (std::uint32_t passes = c == &features ? 2 : 4; passes <= (min_sources == 1 ? 6u : 4u); ++passes) {
+            sup::demo_refining_probe_source src;
+            static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+            src.primary = &primary;
+            src.probe_lights = false;
+            src.primary_sun = &primary_sun;
+            double f = 0;
+            char setting[128];
+            std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min %u src, %u passes", c->name.c_str(),
+                          c->count(), min_sources, passes);
+            if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+          }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {
@@ -404,6 +430,17 @@ class harness {
     return ("," + only_ + ",").find("," + method + ",") != std::string::npos;
   }
 
+  // --match TEXT[|TEXT...]: run only the upsampler and joint-bilateral rows whose setting contains one of them.
+  bool matches(const std::string& setting) const {
+    if (match_.empty()) return true;
+    for (std::size_t b = 0;;) {
+      const std::size_t e = std::min(match_.find('|', b), match_.size());
+      if (e > b && setting.find(match_.substr(b, e - b)) != std::string::npos) return true;
+      if (e == match_.size()) return false;
+      b = e + 1;
+    }
+  }
+
   static int fail(const std::string& message) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", message.c_str());
     return 1;
@@ -424,9 +461,10 @@ class harness {
   template <class Sample, class Source>
   bool run_upsampler(const Source& src, std::uint32_t passes, const std::string& method, const std::string& setting,
                      double& evaluated_fraction, std::uint32_t min_sources = 2) {
+    if (!matches(setting)) return true;
     auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
                                                   {.passes = passes, .max_passes = passes, .rows_per_task = 2,
-                                                   .min_sources = min_sources});
+                                                   .record_kinds = false, .min_sources = min_sources});
     if (!up) return fail(up.error().message()) == 0;
     sup::image img(w_, h_);
     stopwatch t;
@@ -481,6 +519,9 @@ class harness {
   }
 
   void joint_bilateral(int step) {
+    char setting[96];
+    std::snprintf(setting, sizeof setting, "AO+soft on a 1/%d grid, primary+sun per pixel", step);
+    if (!matches(setting)) return;
     // Primary-only shader: primary ray + the hard-shadow ray; AO and soft shadow come from the grid.
     sup::shader_options po = shading_;
     po.ao_rays = 0;
@@ -542,8 +583,6 @@ class harness {
     }
     t.stop();
     }
-    char setting[96];
-    std::snprintf(setting, sizeof setting, "AO+soft on a 1/%d grid, primary+sun per pixel", step);
     add("joint_bilateral", setting, t,
         (static_cast<double>(grid.size()) + static_cast<double>(fallbacks)) / (static_cast<double>(w_) * h_), img);
   }
@@ -599,6 +638,7 @@ class harness {
 
  public:
   std::string only_;
+  std::string match_;
   int repeat_ = 3;  // --repeat N: each method's time is the least of N runs (the machine is shared)
 };
 
@@ -616,7 +656,7 @@ bool parse_int(const char* text, int lo, int hi, int& out) {
 int pareto_upsample(int argc, char** argv) {
   std::string csv;
   bool diagnose = false;
-  std::string only;
+  std::string only, match;
   int repeat = 3;
   int width = 1025, height = 1025, threads = 0, ao = 64, soft = 16;
   for (int i = 1; i < argc; ++i) {
@@ -628,6 +668,8 @@ int pareto_upsample(int argc, char** argv) {
       i += 2;
     } else if (a == "--only" && has1) {
       only = argv[++i];
+    } else if (a == "--match" && has1) {
+      match = argv[++i];
     } else if (a == "--repeat" && has1 && parse_int(argv[i + 1], 1, 100, repeat)) {
       ++i;
     } else if (a == "--diagnose") {
@@ -639,7 +681,7 @@ int pareto_upsample(int argc, char** argv) {
     } else if (a == "--soft" && has1 && parse_int(argv[i + 1], 0, 4096, soft)) {
       ++i;
     } else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--repeat N] [--size W H] [--threads N] [--ao N] [--soft N]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N] [--size W H] [--threads N] [--ao N] [--soft N]\n");
       return 2;
     }
   }
@@ -691,6 +733,7 @@ int pareto_upsample(int argc, char** argv) {
   }
   harness h(*scene, shading, width, height, threads);
   h.only_ = only;
+  h.match_ = match;
   h.repeat_ = repeat;
   return diagnose ? h.diagnose(features) : h.run(csv, features, coarser);
 }

@@ -107,13 +107,21 @@ struct demo_ibuffer_source {
     }
     return s;
   }
-  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
+  // shade() reads the view direction only for the sky and the sun's highlight, so the primary
+  // ray is rebuilt only for those pixels (the same bits as always rebuilding it). The normal is
+  // renormalised (interpolated normals are not unit) unless unit_normals says it is unit.
+  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y, bool unit_normals = false) const {
     shading_inputs in;
-    in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
+    if (s.background() || (s.lights & sun_light_bit) != 0)
+      in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
     if (s.background()) return in;
     in.position = s.position;
-    const float len = glm::length(s.normal);
-    in.normal = len > 0.0f ? s.normal / len : s.normal;
+    if (unit_normals) {
+      in.normal = s.normal;
+    } else {
+      const float len = glm::length(s.normal);
+      in.normal = len > 0.0f ? s.normal / len : s.normal;
+    }
     in.uv = s.texcoord;
     in.geometry = clusters->geometry_of[s.cluster];
     in.light_bits = s.lights;
@@ -130,9 +138,16 @@ struct demo_ibuffer_source {
 // (shader_options{.ao_rays = 0, .soft_shadow_rays = 0, .hard_shadow = probe_lights}). AO and
 // soft shadow (80 of a full evaluation's 82 rays), and without probe_lights the sun bit too, are
 // interpolated; then the sources must agree on the sun bit, as in the plain I-Buffer.
+// Every sample's normal is then an evaluated, unit one (a probe's or a full evaluation's: the
+// probe interpolation takes the probe's), so shade() uses it as it is.
 struct demo_probe_source : demo_ibuffer_source {
   const reference_shader* primary = nullptr;
   bool probe_lights = true;
+
+  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
+    return demo_ibuffer_source::to_inputs(s, x, y, true);
+  }
+  glm::vec3 shade(const demo_sample& s, std::uint32_t x, std::uint32_t y) const { return shader->shade(to_inputs(s, x, y)); }
 
   demo_sample probe(std::uint32_t x, std::uint32_t y) const {
     std::uint64_t rays = 0;
@@ -151,6 +166,21 @@ struct demo_probe_source : demo_ibuffer_source {
     demo_sample s = infolerp::interpolate(p, a, b, c, d);
     if (!probe_lights) s.lights = a.lights;
     return s;
+  }
+};
+
+// The same with cheap probes and refinement (refine_probe, sample_source.hpp): probes trace
+// the primary ray only (`primary` without the sun, probe_lights = false), so a new sample
+// needs two sources of its cluster that agree on the sun bit; only where that fails is the
+// probe refined by `primary_sun` (shader_options{.ao_rays = 0, .soft_shadow_rays = 0}) and
+// completed from the sources that match it, sun bit included. The refinement re-traces the
+// primary ray: the record does not keep the geometric normal the sun ray leaves from.
+struct demo_refining_probe_source : demo_probe_source {
+  const reference_shader* primary_sun = nullptr;
+
+  demo_sample refine_probe(const demo_sample&, std::uint32_t x, std::uint32_t y) const {
+    std::uint64_t rays = 0;
+    return from_inputs(primary_sun->evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height, rays));
   }
 };
 

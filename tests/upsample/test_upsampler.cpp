@@ -178,6 +178,36 @@ struct probing {
   auto shade(const sample& s, std::uint32_t x, std::uint32_t y) const { return inner.shade(s, x, y); }
 };
 
+// A source with cheap probes (refine_probe): the probe leaves out the light bits (poisoned, and
+// probe_compatible() ignores them); refine_probe() adds them.
+template <class Inner>
+struct refining : probing<Inner> {
+  mutable std::atomic<std::uint32_t> probes{0}, refinements{0};
+  sample probe(std::uint32_t x, std::uint32_t y) const {
+    probes.fetch_add(1, std::memory_order_relaxed);
+    sample s = probing<Inner>::probe(x, y);
+    s.lights = 0xDEADu;
+    return s;
+  }
+  bool probe_compatible(const sample& p, const sample& s) const { return p.cluster == s.cluster; }
+  sample interpolate(const sample& p, const sample& a, const sample& b) const {
+    sample s = infolerp::interpolate(p, a, b);
+    s.lights = a.lights;
+    return s;
+  }
+  sample interpolate(const sample& p, const sample& a, const sample& b, const sample& c, const sample& d) const {
+    sample s = infolerp::interpolate(p, a, b, c, d);
+    s.lights = a.lights;
+    return s;
+  }
+  sample refine_probe(const sample& p, std::uint32_t x, std::uint32_t y) const {
+    refinements.fetch_add(1, std::memory_order_relaxed);
+    sample s = probing<Inner>::probe(x, y);
+    CHECK(s.cluster == p.cluster);
+    return s;
+  }
+};
+
 // Cluster 0 everywhere but a one-pixel column of cluster 1 at x = 5, between the even columns
 // the last pass's sources sit on: the sources agree, the pixel itself does not.
 struct thin_line {
@@ -191,6 +221,21 @@ struct thin_line {
     return s;
   }
   float shade(const sample& s, std::uint32_t, std::uint32_t) const { return s.occlusion[0]; }
+};
+
+// Cluster 0 for x < 12, cluster 1 beyond; in shadow (lights 0) at the one-pixel columns x = 5
+// and x = 11, between the even columns the last pass's sources sit on.
+struct shadow_column {
+  using sample_type = sample;
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    sample s;
+    s.cluster = xi >= 12 ? 1u : 0u;
+    s.lights = (xi == 5 || xi == 11) ? 0u : 1u;
+    s.texcoord = {static_cast<float>(xi), static_cast<float>(yi)};
+    s.occlusion = {1.0f, 0.5f};
+    return s;
+  }
+  float shade(const sample& s, std::uint32_t, std::uint32_t) const { return static_cast<float>(s.lights); }
 };
 
 // Pinhole camera at the origin looking along +z (focal length 64 px), a tilted plane n·p = 4;
@@ -543,6 +588,109 @@ TEST_CASE("with probes, serial and parallel outputs are bit-identical", "[upsamp
   REQUIRE_FALSE(bad.ok());
   CHECK(bad.error().code() == infolerp::errc::bad_parameter);
   CHECK(bad.error().message().find("min_sources 3") != std::string::npos);
+}
+
+TEST_CASE("refined probes: refined only where two agreeing sources do not suffice, same result as full probes", "[upsample]") {
+  static_assert(infolerp::refining_sample_source<refining<region_source>>);
+  static_assert(!infolerp::refining_sample_source<probing<region_source>>);
+  for (bool edges : {false, true}) {
+    INFO("cluster and shadow edges " << edges);
+    refining<region_source> src;
+    probing<region_source> full;
+    for (auto* inner : {&src.inner, &full.inner}) {
+      inner->cluster_edge = edges;
+      inner->shadow_edge = edges;
+      inner->background_edge = edges;
+    }
+    const std::uint32_t w = 150, h = 333;
+    for (std::uint32_t min_sources : {1u, 2u})
+      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+        INFO("passes " << passes << " min_sources " << min_sources);
+        auto create = [&] {
+          auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
+                                                              .min_sources = min_sources});
+          REQUIRE(u.ok());
+          return std::move(*u);
+        };
+        auto u = create();
+        src.probes = 0;
+        src.refinements = 0;
+        auto out = poisoned<region_source>(w, h);
+        REQUIRE(u.render(src, std::span<glm::vec4>(out)).ok());
+        const auto ib = u.ibuffer();
+        std::size_t wrong_primary = 0, unset = 0;
+        for (std::uint32_t y = 0; y < h; ++y)
+          for (std::uint32_t x = 0; x < w; ++x) {
+            const sample& s = ib[y * w + x];
+            wrong_primary += same_primary(s, src.inner.evaluate(x, y)) ? 0 : 1;  // light bits included
+            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
+          }
+        CHECK(wrong_primary == 0);
+        CHECK(unset == 0);
+        CHECK(src.probes.load() > 0);
+        if (!edges) CHECK(src.refinements.load() == 0);
+        if (edges) {
+          CHECK(src.refinements.load() > 0);
+          CHECK(src.refinements.load() * 10 < src.probes.load());
+        }
+        // The regions are convex, so two sources that agree on the light bits have the new
+        // sample's: the cheap probes give exactly what full probes give.
+        auto f = create();
+        auto out_full = poisoned<region_source>(w, h);
+        REQUIRE(f.render(full, std::span<glm::vec4>(out_full)).ok());
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < ib.size(); ++i) differ += same_bits(ib[i], f.ibuffer()[i]) ? 0 : 1;
+        CHECK(differ == 0);
+        CHECK(u.stats().evaluated() == f.stats().evaluated());
+        CHECK(std::memcmp(out.data(), out_full.data(), out.size() * sizeof(glm::vec4)) == 0);
+      }
+  }
+}
+
+TEST_CASE("refined probes: a shadow between two agreeing sources is interpolated over, one source refines", "[upsample]") {
+  // The cheap probe cannot see the shadow at x = 5, and the sources on both sides agree, so
+  // the last pass takes their light bits (the documented limit of cheap probes, like the plain
+  // I-Buffer's); at x = 11 one side is another cluster, so the probe is refined and the shadow
+  // found (and, as the one cluster-0 source is lit, the pixel evaluated).
+  refining<shadow_column> src;
+  const std::uint32_t w = 17, h = 9;
+  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = 2, .max_passes = 2, .keep_ibuffer = true, .min_sources = 1});
+  REQUIRE(u.ok());
+  std::vector<float> out(static_cast<std::size_t>(w) * h, -1.0f);
+  REQUIRE(u->render(src, std::span<float>(out)).ok());
+  for (std::uint32_t y = 0; y < h; ++y) {
+    INFO("row " << y);
+    CHECK(out[y * w + 5] == 1.0f);   // sources x = 4 and 6 agree: interpolated over
+    CHECK(out[y * w + 11] == 0.0f);  // source x = 12 is cluster 1: refined, its own shadow
+    CHECK(u->kinds()[y * w + 11] == sample_kind::evaluated);
+  }
+  CHECK(src.refinements.load() >= h);
+}
+
+TEST_CASE("refined probes: serial and parallel outputs are bit-identical", "[upsample]") {
+  refining<wavy> src;
+  const std::uint32_t w = 257, h = 190;
+  for (std::uint32_t min_sources : {1u, 2u}) {
+    auto make_probe = [&] {
+      auto u = infolerp::upsampler<sample>::create(w, h, {.passes = 4, .max_passes = 4, .min_sources = min_sources});
+      REQUIRE(u.ok());
+      return std::move(*u);
+    };
+    auto serial = make_probe();
+    std::vector<glm::vec4> ref(static_cast<std::size_t>(w) * h);
+    REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
+    CHECK(src.refinements.load() > 0);
+    for (unsigned threads : {2u, 8u}) {
+      auto up = make_probe();
+      std::vector<glm::vec4> out(ref.size(), glm::vec4(-7.0f));
+      REQUIRE(up.render(src, std::span<glm::vec4>(out), infolerp::support::thread_pool_executor{threads}).ok());
+      CHECK(std::memcmp(out.data(), ref.data(), out.size() * sizeof(glm::vec4)) == 0);
+      CHECK(std::equal(up.kinds().begin(), up.kinds().end(), serial.kinds().begin()));
+    }
+    const std::size_t before = g_allocations.load();
+    REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
+    CHECK(g_allocations.load() == before);
+  }
 }
 
 TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in perspective", "[upsample]") {

@@ -42,7 +42,14 @@
 // (member or ADL; default compatible(probe, s)), for probes that leave out part of what
 // compatible() compares, e.g. hard-shadow bits that stay interpolated. The upsampler then tests
 // each new sample's own probe against its sources, and the chosen sources against each other
-// with compatible() (upsampler.hpp).
+// with compatible() (upsampler.hpp). Such a source may also offer
+//   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const
+//        the probe with what it left out added (e.g. the hard-shadow rays), so that compatible()
+//        holds between it and a source exactly when it would for the full evaluation
+// and then probes stay cheap: the upsampler refines a probe only where sources that agree
+// with each other and bracket the new sample do not suffice (upsampler.hpp). On the demo
+// scene (1025², 4 passes) 2.8% of the probes are refined with 518 ids, 2.0% with 159, so about
+// 97% of the probes trace no sun ray.
 #include <array>
 #include <concepts>
 #include <cstddef>
@@ -94,8 +101,8 @@ template <std::size_t K, bool L>
 
 // Weights: with a pinhole camera an attribute that is affine on a plane in the world is not
 // affine in screen space, but attribute·inv_depth and inv_depth are; so the perspective-correct
-// value at the screen midpoint weights each sample by its inv_depth (normalised), and the new
-// inv_depth is the plain mean. With inv_depth = 1 everywhere the weights are exactly 1/2 (1/4):
+// value at the screen midpoint weights each sample by its inv_depth (normalised by one
+// reciprocal of the sum), and the new inv_depth is the plain mean. With inv_depth = 1 everywhere the weights are exactly 1/2 (1/4):
 // screen-linear interpolation, exact for attributes linear in screen space.
 
 // Midpoint of an edge: continuous attributes weighted by inv_depth, cluster and light bits
@@ -104,7 +111,8 @@ template <std::size_t K, bool L>
 [[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& a,
                                                          const surface_sample<K, L>& b) noexcept {
   const float sum = a.inv_depth + b.inv_depth;
-  const float ta = a.inv_depth / sum, tb = b.inv_depth / sum;
+  const float r = 1.0f / sum;
+  const float ta = a.inv_depth * r, tb = b.inv_depth * r;
   surface_sample<K, L> s = a;
   s.position = ta * a.position + tb * b.position;
   s.normal = ta * a.normal + tb * b.normal;
@@ -120,7 +128,8 @@ template <std::size_t K, bool L>
                                                          const surface_sample<K, L>& c,
                                                          const surface_sample<K, L>& d) noexcept {
   const float sum = (a.inv_depth + b.inv_depth) + (c.inv_depth + d.inv_depth);
-  const float ta = a.inv_depth / sum, tb = b.inv_depth / sum, tc = c.inv_depth / sum, td = d.inv_depth / sum;
+  const float r = 1.0f / sum;
+  const float ta = a.inv_depth * r, tb = b.inv_depth * r, tc = c.inv_depth * r, td = d.inv_depth * r;
   surface_sample<K, L> s = a;
   s.position = (ta * a.position + tb * b.position) + (tc * c.position + td * d.position);
   s.normal = (ta * a.normal + tb * b.normal) + (tc * c.normal + td * d.normal);
@@ -138,7 +147,8 @@ template <std::size_t K, bool L>
 [[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& probe, const surface_sample<K, L>& a,
                                                          const surface_sample<K, L>& b) noexcept {
   const float sum = a.inv_depth + b.inv_depth;
-  const float ta = a.inv_depth / sum, tb = b.inv_depth / sum;
+  const float r = 1.0f / sum;
+  const float ta = a.inv_depth * r, tb = b.inv_depth * r;
   surface_sample<K, L> s = probe;
   for (std::size_t i = 0; i < K; ++i) s.occlusion[i] = ta * a.occlusion[i] + tb * b.occlusion[i];
   return s;
@@ -150,7 +160,8 @@ template <std::size_t K, bool L>
                                                          const surface_sample<K, L>& b, const surface_sample<K, L>& c,
                                                          const surface_sample<K, L>& d) noexcept {
   const float sum = (a.inv_depth + b.inv_depth) + (c.inv_depth + d.inv_depth);
-  const float ta = a.inv_depth / sum, tb = b.inv_depth / sum, tc = c.inv_depth / sum, td = d.inv_depth / sum;
+  const float r = 1.0f / sum;
+  const float ta = a.inv_depth * r, tb = b.inv_depth * r, tc = c.inv_depth * r, td = d.inv_depth * r;
   surface_sample<K, L> s = probe;
   for (std::size_t i = 0; i < K; ++i)
     s.occlusion[i] = (ta * a.occlusion[i] + tb * b.occlusion[i]) + (tc * c.occlusion[i] + td * d.occlusion[i]);
@@ -216,6 +227,15 @@ concept probing_sample_source = sample_source<S> &&
       { s.probe(x, x) } -> std::convertible_to<typename S::sample_type>;
     } &&
     (detail::member_probe_interpolate<S> || detail::adl_probe_interpolate<typename S::sample_type>);
+
+// A probing source whose probes may leave out part of what compatible() compares (e.g. the
+// hard-shadow bits, tested only with probe_compatible()) and that can add it afterwards
+// (see the top of this file).
+template <class S>
+concept refining_sample_source = probing_sample_source<S> &&
+    requires(const S& s, std::uint32_t x, const typename S::sample_type& p) {
+      { s.refine_probe(p, x, x) } -> std::convertible_to<typename S::sample_type>;
+    };
 
 // One readable message per missing piece instead of template noise.
 template <class S>

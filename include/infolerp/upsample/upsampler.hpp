@@ -23,16 +23,26 @@
 // shadows) from the previous-pass sources that match its probe (see probe_row for which);
 // with no match it is evaluated. Cost: one probe per new sample (each pixel is probed once:
 // R samples keep their probe), so a probe must be much cheaper than an evaluation to pay off.
+// Cheaper still, a source may probe only the primary ray and refine a probe with the
+// hard-shadow rays where the sources that agree with each other and bracket the new sample do
+// not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// sun, 2 threads, process CPU time, least of 3 runs; full per-pixel evaluation 3.23 s):
-//   plain, demo thresholds (518 ids):     4 passes 8.4x 45.7 dB, 5 passes 9.0x 44.0 dB
-//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 12.9x 40.5 dB
-//   probes, 518 ids, min_sources 1:       4 passes 10.4x 54.3 dB, 5 passes 11.7x 50.4 dB
-//   probes, 131 ids, min_sources 1:       5 passes 12.8x 49.0 dB, 6 passes 13.4x 44.7 dB
+// sun, 2 threads, process CPU time, least of 3 runs, load average 4-5.5; full per-pixel
+// evaluation 3.24 s):
+//   plain, demo thresholds (518 ids):     4 passes 8.8x 45.7 dB, 5 passes 9.5x 44.0 dB
+//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 13.0x 40.5 dB
+//   probes (primary + sun), 518 ids:      4 passes 10.4x 54.3 dB, 5 passes 12.5x 50.4 dB
+//   probes (primary + sun), 131 ids:      5 passes 13.0x 49.0 dB, 6 passes 13.5x 44.7 dB
+//   refined probes (primary, sun where needed), min_sources 1:
+//     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 7.9x 56.8 dB, 4 passes 11.6x 53.9 dB, 5 passes 13.9x 49.7 dB
+//     159 ids: 4 passes 12.9x 53.1 dB, 5 passes 15.0x 48.8 dB, 6 passes 15.5x 45.0 dB
+//   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.1x 59.5 dB,
+//     1/4 7.5x 56.0 dB, 1/8 12.0x 53.0 dB, 1/16 14.0x 48.4 dB; the refined probes beat each
+//     of these with less CPU time (5-7% less) and a higher PSNR.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
-// BM_UpsampleInterpolatedPixel) is 9–15 ns per interpolated pixel, 19 ns with probes (the
-// probe included).
+// BM_UpsampleInterpolatedPixel) is 9–14 ns per interpolated pixel, 19 ns with probes, 22 ns
+// with refined probes (the probes included).
 //
 // Determinism: each output row of a pass depends only on the previous pass, so rows run in
 // parallel through the user's executor and the output is identical for any executor and thread
@@ -215,7 +225,8 @@ class upsampler {
   // out[i] = src.shade(sample, x, y) for the final I-Buffer sample of each pixel.
   // Preconditions: out.size() == width·height (else errc::bad_size, nothing written).
   // Complexity: E·(cost of evaluate) + W·H·(cost of interpolate + shade) over the executor,
-  // plus about W·H·(cost of probe) for sources with probes;
+  // plus about W·H·(cost of probe) for sources with probes (and refine_probe for the few probes
+  // that need it);
   // E ≈ (W·H)/4^(passes−1) + (cluster and shadow boundary samples). Allocation: none.
   // Thread-safety: src's const members are called concurrently (see sample_source.hpp).
   // Output is bit-identical for every executor and thread count.
@@ -377,11 +388,12 @@ class upsampler {
   }
 
   // Later passes with probes: R as above; every new sample probes its own pixel and is
-  // interpolated from the sources compatible with its probe. Edge: both sources, or one when
-  // min_sources is 1. Centre, by the compatible corners: all four (weights 1/4); three, the
-  // diagonal opposite the missing corner (the centre is its midpoint, so a plane through the
-  // three corners is reproduced exactly); two, that pair; one, that corner when min_sources is
-  // 1. Otherwise evaluated.
+  // interpolated from the sources compatible with its probe (choose_sources). A source that
+  // can refine its probes (refine_probe, sample_source.hpp) probes cheaply first and needs
+  // sources that agree with each other and bracket the new sample (both of an edge; all four
+  // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
+  // leaves out is taken from sources on both sides of it; only where that fails is the probe
+  // refined and tested again, now with compatible() and min_sources. Otherwise evaluated.
   template <class S, class Pixel>
   void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
                  std::array<std::size_t, 3>& counts) {
@@ -391,63 +403,93 @@ class upsampler {
     // Sources that match the probe match each other (compatible() is an equivalence), unless
     // the probe is tested with a probe_compatible() that leaves something out.
     constexpr bool cross_check = detail::member_probe_compatible<S> || detail::adl_probe_compatible<Sample>;
+    const auto probe_match = [&](const Sample& p, const Sample& s) { return detail::may_complete(src, p, s); };
     const Sample* prev = levels_[d + 1].data();
     const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;
     const Sample* r1 = (j & 1u) ? r0 + pw : r0;
     for (std::uint32_t i = 0; i < w; ++i) {
-      const std::uint32_t a = i / 2;
       if ((j & 1u) == 0 && (i & 1u) == 0) {
-        store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
+        store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
         continue;
       }
       const std::uint32_t x = i << d, y = j << d;
       Sample p = src.probe(x, y);
-      const bool centre = (i & 1u) && (j & 1u);
-      if (!centre) {
-        const Sample& s0 = r0[a];
-        const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
-        const bool m0 = detail::may_complete(src, p, s0), m1 = detail::may_complete(src, p, s1);
-        if (m0 && m1 && (!cross_check || detail::may_interpolate(src, s0, s1))) {
-          store(src, d, i, j, detail::source_interpolate(src, p, s0, s1), sample_kind::interpolated, out, counts);
-        } else if (single && (m0 || m1)) {
-          const Sample& s = m0 ? s0 : s1;
-          store(src, d, i, j, detail::source_interpolate(src, p, s, s), sample_kind::interpolated, out, counts);
-        } else {
-          store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+      chosen k;
+      if constexpr (refining_sample_source<S>) {
+        k = choose_sources(src, p, r0, r1, i, j, false, cross_check, true, probe_match);
+        if (k.n == 0) {
+          p = src.refine_probe(p, x, y);
+          const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
+          k = choose_sources(src, p, r0, r1, i, j, single, false, false, full_match);
         }
-        continue;
-      }
-      const Sample* c[4] = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
-      unsigned mask = 0;
-      for (unsigned k = 0; k < 4; ++k) mask |= detail::may_complete(src, p, *c[k]) ? 1u << k : 0u;
-      if (cross_check && mask == 0xF &&
-          !(detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
-            detail::may_interpolate(src, *c[0], *c[3])))
-        mask = 0;  // the four disagree among themselves (e.g. light bits the probe leaves out): evaluate
-      const Sample* s0 = nullptr;
-      const Sample* s1 = nullptr;
-      switch (mask) {
-        case 0xF:
-          store(src, d, i, j, detail::source_interpolate(src, p, *c[0], *c[1], *c[2], *c[3]), sample_kind::interpolated,
-                out, counts);
-          continue;
-        case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
-        case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
-        case 0x3: s0 = c[0]; s1 = c[1]; break;                      // adjacent pairs
-        case 0xC: s0 = c[2]; s1 = c[3]; break;
-        case 0x5: s0 = c[0]; s1 = c[2]; break;
-        case 0xA: s0 = c[1]; s1 = c[3]; break;
-        case 0x1: case 0x2: case 0x4: case 0x8:
-          if (single) s0 = s1 = c[mask == 0x1 ? 0 : mask == 0x2 ? 1 : mask == 0x4 ? 2 : 3];
-          break;
-        default: break;
-      }
-      if (s0 != nullptr && (!cross_check || detail::may_interpolate(src, *s0, *s1))) {
-        store(src, d, i, j, detail::source_interpolate(src, p, *s0, *s1), sample_kind::interpolated, out, counts);
       } else {
+        k = choose_sources(src, p, r0, r1, i, j, single, cross_check, false, probe_match);
+      }
+      if (k.n == 0) {
         store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+      } else if (k.n == 4) {
+        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
+              sample_kind::interpolated, out, counts);
+      } else {
+        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1]), sample_kind::interpolated, out,
+              counts);
       }
     }
+  }
+
+  // The previous-pass sources that complete probe p: all four corners (n = 4), two sources or
+  // one twice (n = 2), or none (n = 0).
+  struct chosen {
+    std::array<const Sample*, 4> c{};
+    unsigned n = 0;
+  };
+
+  // Chooses the sources of probe p of the new sample (i, j) among the previous-pass samples
+  // (rows r0 and r1) that match(p, source) accepts. Edge: both sources, or one when `single`.
+  // Centre, by the matching corners: all four (weights 1/4); three, the diagonal opposite the
+  // missing corner (the centre is its midpoint, so a plane through the three corners is
+  // reproduced exactly); two, that pair; one, that corner when `single`. With `cross`, the
+  // chosen sources must also be compatible() with each other; with `bracket`, an adjacent pair
+  // of corners (the centre is not between them) does not suffice.
+  template <class S, class M>
+  static chosen choose_sources(const S& src, const Sample& p, const Sample* r0, const Sample* r1, std::uint32_t i,
+                               std::uint32_t j, bool single, bool cross, bool bracket, const M& match) {
+    const std::uint32_t a = i / 2;
+    if (!((i & 1u) && (j & 1u))) {  // edge
+      const Sample* s0 = &r0[a];
+      const Sample* s1 = (j & 1u) ? &r1[a] : &r0[a + 1];
+      const bool m0 = match(p, *s0), m1 = match(p, *s1);
+      if (m0 && m1 && (!cross || detail::may_interpolate(src, *s0, *s1))) return {{s0, s1}, 2};
+      if (single && (m0 || m1)) return {{m0 ? s0 : s1, m0 ? s0 : s1}, 2};
+      return {};
+    }
+    const std::array<const Sample*, 4> c = {&r0[a], &r0[a + 1], &r1[a], &r1[a + 1]};  // 00, 10, 01, 11: diagonals {0, 3}, {1, 2}
+    unsigned mask = 0;
+    for (unsigned k = 0; k < 4; ++k) mask |= match(p, *c[k]) ? 1u << k : 0u;
+    if (mask == 0xF) {
+      if (!cross || (detail::may_interpolate(src, *c[0], *c[1]) && detail::may_interpolate(src, *c[0], *c[2]) &&
+                     detail::may_interpolate(src, *c[0], *c[3])))
+        return {c, 4};
+      return {};  // the four disagree among themselves (e.g. light bits the probe leaves out)
+    }
+    const Sample* s0 = nullptr;
+    const Sample* s1 = nullptr;
+    switch (mask) {
+      case 0xE: case 0x7: case 0x6: s0 = c[1]; s1 = c[2]; break;  // no 00 or no 11: diagonal 10-01
+      case 0xD: case 0xB: case 0x9: s0 = c[0]; s1 = c[3]; break;  // no 10 or no 01: diagonal 00-11
+      case 0x3: case 0xC: case 0x5: case 0xA:  // adjacent pairs
+        if (!bracket) {
+          s0 = c[mask == 0xC ? 2 : mask == 0xA ? 1 : 0];
+          s1 = c[mask == 0x3 ? 1 : mask == 0x5 ? 2 : 3];
+        }
+        break;
+      case 0x1: case 0x2: case 0x4: case 0x8:
+        if (single) s0 = s1 = c[mask == 0x1 ? 0 : mask == 0x2 ? 1 : mask == 0x4 ? 2 : 3];
+        break;
+      default: break;
+    }
+    if (s0 == nullptr || (cross && !detail::may_interpolate(src, *s0, *s1))) return {};
+    return {{s0, s1}, 2};
   }
 
   upsampler_options options_{};
