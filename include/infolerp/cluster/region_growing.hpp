@@ -90,6 +90,11 @@ inline constexpr float js_unknown = -1.0f;
 inline constexpr float js_bounded = -3.0f;
 
 template <class S>
+concept has_mutual_information_lower_bound = requires(const S& s, std::uint32_t a) {
+  { s.mutual_information_lower_bound(a) } -> std::convertible_to<double>;
+};
+
+template <class S>
 concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
   { s.surely_within(a, a, th) } -> std::convertible_to<bool>;
 };
@@ -156,9 +161,23 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
   static_assert(channel_state<S>);
   const std::size_t u = s.class_count();
   std::vector<double> mi(u);
-  for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information(static_cast<std::uint32_t>(c));
-  });
+  if constexpr (detail::has_mutual_information_lower_bound<S>) {
+    // MI only where the bound allows it to reach the MI of the class of smallest bound (all
+    // classes of minimum MI among them); the others get +inf, which cannot be the minimum.
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information_lower_bound(static_cast<std::uint32_t>(c));
+    });
+    const auto lowest = static_cast<std::uint32_t>(std::min_element(mi.begin(), mi.end()) - mi.begin());
+    const double reach = s.mutual_information(lowest) + 1e-9;
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c)
+        mi[c] = mi[c] <= reach ? s.mutual_information(static_cast<std::uint32_t>(c)) : std::numeric_limits<double>::infinity();
+    });
+  } else {
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information(static_cast<std::uint32_t>(c));
+    });
+  }
   std::uint32_t next = 0;
   for (std::uint32_t c = 1; c < u; ++c)
     if (mi[c] < mi[next]) next = c;
