@@ -156,7 +156,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
     const std::uint32_t cluster_a = ca;  // clang++ 14 cannot capture a structured binding
     auto prefers_other = [&](std::uint32_t i) {
-      const std::uint32_t c = s.class_of(i);
+      std::uint32_t c = s.class_of(i);
+      if constexpr (detail::has_representative<S>) c = s.representative(c);  // bit-identical JS
       if (stamp[c] != pair_index) {
         stamp[c] = pair_index;
         js_a[c] = s.divergence(c, seed_a);

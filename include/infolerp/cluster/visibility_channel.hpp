@@ -23,9 +23,11 @@
 // OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -118,6 +120,9 @@ class visibility_state {
   std::span<const float> row(std::uint32_t t) const { return {rows_.data() + std::size_t{t} * n_, n_}; }
   double input_probability(std::uint32_t t) const { return p_[t]; }
   bool unseen(std::uint32_t t) const { return !(p_[t] > 0.0); }
+  // The smallest element whose row and p(t) are bit-identical to t's (t itself when none):
+  // every divergence from it is bit-identical to t's, so JS columns and memos are shared.
+  std::uint32_t representative(std::uint32_t t) const { return rep_[t]; }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
@@ -175,7 +180,45 @@ class visibility_state {
   std::vector<float> rows_;     // M × N
   std::vector<double> p_;       // p(t)
   std::vector<double> output_;  // p(v)
+  std::vector<std::uint32_t> rep_;  // representative(t)
   bool all_alike_ = false;
+
+  // rep_ by an open-addressing hash table of rows (bit patterns of the row and of p(t)).
+  // O(M·N), allocation O(M).
+  void find_representatives() {
+    const std::size_t m = p_.size();
+    rep_.resize(m);
+    std::size_t size = 1;
+    while (size < 2 * m) size *= 2;
+    std::vector<std::uint32_t> table(size, invalid_id);
+    const std::size_t bytes = n_ * sizeof(float);
+    for (std::uint32_t t = 0; t < m; ++t) {
+      const float* r = rows_.data() + std::size_t{t} * n_;
+      constexpr std::uint64_t k = 0x9E3779B97F4A7C15ull;
+      std::uint64_t h0 = std::bit_cast<std::uint64_t>(p_[t]), h1 = 1, h2 = 2, h3 = 3;  // independent chains
+      std::size_t v = 0;
+      for (; v + 4 <= n_; v += 4) {
+        h0 = (h0 ^ std::bit_cast<std::uint32_t>(r[v])) * k;
+        h1 = (h1 ^ std::bit_cast<std::uint32_t>(r[v + 1])) * k;
+        h2 = (h2 ^ std::bit_cast<std::uint32_t>(r[v + 2])) * k;
+        h3 = (h3 ^ std::bit_cast<std::uint32_t>(r[v + 3])) * k;
+      }
+      for (; v < n_; ++v) h0 = (h0 ^ std::bit_cast<std::uint32_t>(r[v])) * k;
+      const std::uint64_t h = h0 ^ (h1 >> 13) ^ (h2 >> 26) ^ (h3 >> 39);
+      for (std::size_t slot = (h ^ (h >> 29)) & (size - 1);; slot = (slot + 1) & (size - 1)) {
+        const std::uint32_t o = table[slot];
+        if (o == invalid_id) {
+          table[slot] = rep_[t] = t;
+          break;
+        }
+        if (std::bit_cast<std::uint64_t>(p_[o]) == std::bit_cast<std::uint64_t>(p_[t]) &&
+            std::memcmp(rows_.data() + std::size_t{o} * n_, r, bytes) == 0) {
+          rep_[t] = o;
+          break;
+        }
+      }
+    }
+  }
 };
 
 // Visibility measured once for a mesh: visible-sample counts per (triangle, viewpoint).
@@ -219,6 +262,7 @@ struct prepared_visibility_channel {
     s.output_.assign(n, 0.0);
     if (active == 0) {  // nothing of the set is seen from anywhere: one class, all alike
       s.all_alike_ = true;
+      s.rep_.assign(m, 0);
       return s;
     }
     const double pv = 1.0 / static_cast<double>(active);
@@ -240,11 +284,8 @@ struct prepared_visibility_channel {
         for (std::size_t v = 0; v < n; ++v) s.rows_[i * n + v] = static_cast<float>(pv * ptv[v] / pt);
     }
     if (denoise && threshold > 0.0) denoise_rows(triangles, s);
-    s.all_alike_ = true;
-    for (std::size_t i = 1; i < m && s.all_alike_; ++i)
-      s.all_alike_ = s.p_[i] == s.p_[0] &&
-                     std::equal(s.rows_.begin() + static_cast<std::ptrdiff_t>(i * n),
-                                s.rows_.begin() + static_cast<std::ptrdiff_t>((i + 1) * n), s.rows_.begin());
+    s.find_representatives();
+    s.all_alike_ = std::all_of(s.rep_.begin(), s.rep_.end(), [](std::uint32_t r) { return r == 0; });
     return s;
   }
 
