@@ -101,10 +101,13 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   // binary search in `path` (all 0 between pairs).
   std::vector<std::uint64_t> path_filter(1024, 0);
   auto filter_bit = [](std::uint64_t key) { return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 48); };
-  // JS to the pair's two seeds, memoised per class for the current pair.
+  // JS(class, seed of a cluster), memoised per (cluster, class) over all pairs when
+  // clusters × classes <= 2^20 (binned direct channels), else per (side of the pair, class)
+  // for the current pair only (an entry is valid when its stamp is `valid`).
   const std::size_t u = s.class_count();
-  std::vector<double> js_a(u), js_b(u);
-  std::vector<std::uint32_t> stamp(u, invalid_id);
+  const bool dense = std::size_t{k} * u <= (std::size_t{1} << 20);
+  std::vector<double> js((dense ? k : 2) * u);
+  std::vector<std::uint32_t> stamp(js.size(), 0);
   std::uint32_t pair_index = 0;
   for (const auto& pair : pairs) {
     // Plain variables, not a structured binding: the lambda below captures them, which
@@ -153,17 +156,21 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (!simple || endpoints.size() != 2) continue;
 
     // 2. The band.
-    const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
-    const std::uint32_t cluster_a = ca;  // clang++ 14 cannot capture a structured binding
+    const std::uint32_t cluster_a = ca, cluster_b = cb;  // clang++ 14 cannot capture a structured binding
+    const std::uint32_t valid = dense ? 1u : pair_index;
+    auto js_to = [&](std::uint32_t c, std::uint32_t cluster, std::uint32_t side) {
+      const std::size_t e = (dense ? cluster : side) * u + c;
+      if (stamp[e] != valid) {
+        stamp[e] = valid;
+        js[e] = s.divergence(c, s.class_of(r.seeds[cluster]));
+      }
+      return js[e];
+    };
     auto prefers_other = [&](std::uint32_t i) {
       std::uint32_t c = s.class_of(i);
       if constexpr (detail::has_representative<S>) c = s.representative(c);  // bit-identical JS
-      if (stamp[c] != pair_index) {
-        stamp[c] = pair_index;
-        js_a[c] = s.divergence(c, seed_a);
-        js_b[c] = s.divergence(c, seed_b);
-      }
-      return label[i] == cluster_a ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
+      const double js_a = js_to(c, cluster_a, 0), js_b = js_to(c, cluster_b, 1);
+      return label[i] == cluster_a ? js_b < js_a : js_a < js_b;
     };
     band.clear();
     for (std::uint32_t i : frontier)
