@@ -98,8 +98,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   using item = std::pair<double, std::uint32_t>;
   std::vector<item> heap;
   // A 2^16-bit filter of the path's edge keys, so the split's flood fill rarely needs the
-  // binary search in `path` (all 0 between pairs).
-  std::vector<std::uint64_t> path_filter(1024, 0);
+  // binary search in `path` (all 0 between pairs; allocated at the first split tried).
+  std::vector<std::uint64_t> path_filter;
   auto filter_bit = [](std::uint64_t key) { return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 48); };
   // JS(class, seed of a cluster), memoised per (cluster, class) over all pairs when
   // clusters × classes <= 2^20 (binned direct channels), else per (side of the pair, class)
@@ -261,6 +261,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     for (std::uint32_t v = goal; v != start; v = from[v]) path.push_back(detail::edge_key(verts[v], verts[from[v]]));
     std::sort(path.begin(), path.end());
     if (path == boundary) continue;
+    if (path_filter.empty()) path_filter.assign(1024, 0);
     for (auto e : path) path_filter[filter_bit(e) >> 6] |= std::uint64_t{1} << (filter_bit(e) & 63);
     auto on_path = [&](std::uint64_t e) {
       return (path_filter[filter_bit(e) >> 6] >> (filter_bit(e) & 63) & 1) && std::binary_search(path.begin(), path.end(), e);
