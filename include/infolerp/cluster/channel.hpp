@@ -93,8 +93,10 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 //
 // Kernel requirements: class_count(), count(c) (elements in class c, as double),
 //   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
-// Allocation: O(U) at construction; divergence(), divergences() and mutual_information() build
-// rows in per-thread scratch buffers (2U doubles per thread, allocated once and reused).
+// Allocation: U² doubles at construction when U <= max_stored_rows (256, 512 KB): the rows built
+// for Eq. (1) are kept and divergence(), divergences() and mutual_information() read them;
+// above that O(U), and those build rows in per-thread scratch buffers (2U doubles per thread,
+// allocated once and reused).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
@@ -103,15 +105,19 @@ class direct_channel_state {
       : class_of_(std::move(class_of)), kernel_(std::move(kernel)) {
     const std::size_t u = kernel_.class_count();
     output_.assign(u, 0.0);
-    std::vector<double> r(u);
+    if (u <= max_stored_rows) rows_.resize(u * u);
+    std::vector<double> scratch_row(rows_.empty() ? u : 0);
     const double m = static_cast<double>(class_of_.size());
     // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U²).
     for (std::uint32_t a = 0; a < u; ++a) {
+      const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * u, u);
       row(a, r);
       const double w = kernel_.count(a) / m;
       for (std::size_t c = 0; c < u; ++c) output_[c] += w * r[c];
     }
   }
+  // Up to this many classes the rows built for Eq. (1) are kept (U² doubles, 512 KB at most).
+  static constexpr std::size_t max_stored_rows = 256;
 
   std::size_t element_count() const { return class_of_.size(); }
   std::size_t class_count() const { return kernel_.class_count(); }
@@ -131,36 +137,35 @@ class direct_channel_state {
     }
   }
 
-  double mutual_information(std::uint32_t a) const {
-    const std::span<double> r = scratch(0);
-    row(a, r);
-    return element_mutual_information(r, output_);
-  }
+  double mutual_information(std::uint32_t a) const { return element_mutual_information(row_of(a, 0), output_); }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
-    const std::span<double> ra = scratch(0), rb = scratch(1);
-    row(a, ra);
-    row(b, rb);
-    return js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5);
+    return js_divergence(row_of(a, 0), row_of(b, 1), 0.5);
   }
 
   // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
   void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
-    const std::span<double> ra = scratch(0), rb = scratch(1);
-    row(a, ra);
+    const std::span<const double> ra = row_of(a, 0);
     for (std::size_t i = 0; i < out.size(); ++i) {
       const auto b = static_cast<std::uint32_t>(first + i);
       if (b == a) {
         out[i] = 0.0f;
         continue;
       }
-      row(b, rb);
-      out[i] = static_cast<float>(js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5));
+      out[i] = static_cast<float>(js_divergence(ra, row_of(b, 1), 0.5));
     }
   }
 
  private:
+  // The row of class a: stored, or built in scratch row `which` (0 or 1).
+  std::span<const double> row_of(std::uint32_t a, std::size_t which) const {
+    const std::size_t u = class_count();
+    if (!rows_.empty()) return {rows_.data() + a * u, u};
+    const std::span<double> r = scratch(which);
+    row(a, r);
+    return r;
+  }
   // Scratch row `which` (0 or 1) of class_count() doubles, per thread.
   std::span<double> scratch(std::size_t which) const {
     thread_local std::vector<double> buffers[2];
@@ -172,6 +177,7 @@ class direct_channel_state {
   std::vector<std::uint32_t> class_of_;
   Kernel kernel_;
   std::vector<double> output_;
+  std::vector<double> rows_;  // U × U when U <= max_stored_rows, else empty
 };
 
 }  // namespace infolerp
