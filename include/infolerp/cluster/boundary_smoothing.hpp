@@ -53,8 +53,12 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
 // Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
-// plus O(band · log band); divergences only for the boundary and band triangles.
-// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call).
+// plus O(band · log band); divergences only for the boundary and band triangles, each
+// JS(class, seed) once per set when clusters × classes <= 2^20 (else once per pair), once per
+// representative when the state has representative().
+// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
+// 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
+// per-pair buffers are reused from pair to pair.
 template <class S, class M>
 std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
                                 double threshold, region_growing_result& r) {

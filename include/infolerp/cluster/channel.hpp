@@ -42,6 +42,10 @@ namespace infolerp {
 //   all_alike() -> bool: every row is identical (the clustering then skips all work)
 //   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th (false
 //       may mean either); growth then needs the exact JS only where two seeds claim an element
+//   mutual_information_lower_bound(c) -> double: <= mutual_information(c) up to 1e-9; the first
+//       seed then evaluates MI only for classes whose bound can reach the smallest MI
+//   representative(c) -> class r <= c whose divergences to every class are bit-identical to
+//       c's (r == c when none); JS columns and smoothing memos are then shared within a group
 // Thread-safety: const members are called concurrently from the executor's threads.
 template <class S>
 concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {

@@ -10,10 +10,14 @@
 //   Th = 1, or all rows alike   one cluster per connected component, no divergence evaluated.
 //   seeds        first: the class with minimum I(x;Y); next: the class with maximum summed JS
 //                to the seeds so far among those with JS > Th to every seed; stop when none.
+//                With the state's mutual_information_lower_bound, MI is evaluated only where
+//                the bound is within 1e-9 of the MI of the class of smallest bound.
 //                Lazy: a seed's JS is evaluated (in parallel) only for the classes still
 //                candidates, and during growth only where its frontier arrives, once per
 //                (seed, class); with the state's surely_within, growth evaluates it exactly
-//                only where two seeds claim an element in the same ring. Same result.
+//                only where two seeds claim an element in the same ring. With the state's
+//                representative(), an entry whose representative is evaluated in the same
+//                batch is copied from it (bit-identical). Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.

@@ -17,6 +17,8 @@
 // Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
 // its edge neighbours in the set with JS <= Th (most tests are decided by an upper bound on JS
 // without logarithms, see visibility_state::surely_within).
+// Rows that are bit-identical (row and p(t)) after denoising share their divergences through
+// visibility_state::representative (69k groups for 89k triangles on refined_elephant).
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
@@ -243,8 +245,9 @@ struct prepared_visibility_channel {
 
   // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
   // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, + O(M log M)
-  // to find neighbours in the set when it is under 1/8 of the mesh). Allocation O(M·N) floats
-  // (+ T ids for a set of at least 1/8 of the mesh).
+  // to find neighbours in the set when it is under 1/8 of the mesh, + O(M·N) to find the
+  // representatives). Allocation O(M·N) floats (+ T ids for a set of at least 1/8 of the mesh,
+  // + 3M ids for the representatives and their hash table).
   result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
