@@ -8,9 +8,10 @@
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
 // Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
-//   BM_Clustering_RefinedElephant   ~270 ms at load 4.7 (265 / 272 / 271; clang++ 14: 262 / 267);
-//     the previous version (merge fe8850b, ~310 ms at load 2-4) measured 319 / 320 / 322 in the
-//     same alternating runs, ~1070 ms before the issue-3 speed work; clusters identical
+//   BM_Clustering_RefinedElephant   ~250 ms at load 2.3 (251 / 252; clang++ 14: 243 / 250) and
+//     ~270 ms at load 4.7 (265 / 272 / 271); the previous version (merge fe8850b) measured
+//     295 / 301 and 319 / 320 / 322 in the same alternating runs, ~1070 ms before the issue-3
+//     speed work; clusters identical
 //     throughout (34 / 1960 / 4248). Goal <= 150 ms NOT met. CPU per call (thread CPU time,
 //     load 4.8, so inflated): visibility ~172 (init + denoising ~47, seeds and growth ~68,
 //     boundary smoothing ~57), orientation ~40 (growth 14, smoothing 24), stretch ~35 (growth
