@@ -7,18 +7,23 @@
 //                                   of its own rays through the same tracer. Goal ≤ 1.3×.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
-// Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM at load 2-4, 2026-12-01):
-//   BM_Clustering_RefinedElephant   ~310 ms (clang++ 14: ~315 ms); the code before the issue-3
-//     speed work measured ~1070 ms in the same runs, with identical clusters (34 / 1960 / 4248).
-//     Goal ≤ 150 ms NOT met. CPU per call: visibility ~180 (init + denoising 37, seeds and
-//     growth 80, boundary smoothing 61), orientation ~51 (growth 17, smoothing 31), stretch ~46
-//     (growth 22, smoothing 10, texture stretch 7), topology and checks 6. About 640k 64-bin
-//     JS evaluations remain in the visibility channel (seed search 220k, growth 50k,
-//     smoothing 90k; denoising decides all but ~40 of its 267k tests by a bound).
+// Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
+//   BM_Clustering_RefinedElephant   ~250 ms at load 2.3 (251 / 252; clang++ 14: 243 / 250) and
+//     ~270 ms at load 4.7 (265 / 272 / 271); the previous version (merge fe8850b) measured
+//     295 / 301 and 319 / 320 / 322 in the same alternating runs, ~1070 ms before the issue-3
+//     speed work; clusters identical
+//     throughout (34 / 1960 / 4248). Goal <= 150 ms NOT met. CPU per call (thread CPU time,
+//     load 4.8, so inflated): visibility ~172 (init + denoising ~47, seeds and growth ~68,
+//     boundary smoothing ~57), orientation ~40 (growth 14, smoothing 24), stretch ~35 (growth
+//     19, smoothing 9, init with texture stretch 6). Visibility JS evaluations (64 bins):
+//     seed search 173k, growth 52k, smoothing 73k (from 220k / 50k / 90k: bit-identical rows
+//     share their JS, 69k groups for 89k rows); I(t;V) evaluated for ~1k rows (from 89k: a
+//     log-free lower bound rules the rest out); denoising decides nearly all its tests by a bound.
 //   BM_OrientationChannel (2304-triangle torus, Th 0.02): exact 262 ms; K = 64/256/1024/4096:
-//     0.42 / 4.4 / 36 / 108 ms, ARI vs exact 0.43 / 0.35 / 0.49 / 0.63 (K = 1024: 7.2× less
-//     time, ARI 0.49: goal ≥ 0.99 at ≥ 10× NOT met).
-//   BM_StretchChannel (64×32 UV sphere, Th 0.005): exact ~200 ms; binned 0.15–0.18 ms at every
+//     0.28 / 2.9 / 36 / 107 ms (64 and 256 from 0.41 / 4.3: rows of up to 256 classes are
+//     stored), ARI vs exact 0.43 / 0.35 / 0.49 / 0.63 (K = 1024: 7.2× less time, ARI 0.49:
+//     goal ≥ 0.99 at ≥ 10× NOT met).
+//   BM_StretchChannel (64×32 UV sphere, Th 0.005): exact ~200 ms; binned 0.14–0.16 ms at every
 //     K, ARI 0.66 (2 clusters against 42 exact): goal NOT met.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>

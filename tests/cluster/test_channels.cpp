@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <vector>
@@ -242,6 +243,48 @@ TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][vi
   REQUIRE(checked > 10000);
   REQUIRE(below > checked / 4);
   REQUIRE(below < checked);
+}
+
+TEST_CASE("visibility: representatives have bit-identical rows and divergences; MI bound below MI", "[cluster][visibility]") {
+  // The bumpy sphere under a roof again: symmetric rows and unseen triangles give groups.
+  indexed_mesh scene = support::make_uv_sphere(16, 10);
+  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
+  test::brute_tracer tracer(scene);
+  auto topo = build_topology(scene);
+  REQUIRE(topo.ok());
+  serial_executor exec;
+  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
+  REQUIRE(p.ok());
+  auto s = p->init(all_triangles(scene.triangles.size()));
+  REQUIRE(s.ok());
+  const auto m = static_cast<std::uint32_t>(s->element_count());
+  auto same = [&](std::uint32_t a, std::uint32_t b) {
+    const auto ra = s->row(a), rb = s->row(b);
+    return std::memcmp(ra.data(), rb.data(), ra.size_bytes()) == 0 && s->input_probability(a) == s->input_probability(b);
+  };
+  std::size_t shared = 0, positive_bounds = 0;
+  for (std::uint32_t t = 0; t < m; ++t) {
+    const std::uint32_t r = s->representative(t);
+    REQUIRE(r <= t);
+    REQUIRE(same(r, t));
+    REQUIRE(s->representative(r) == r);
+    shared += r != t;
+    for (std::uint32_t b = 0; b < t; ++b)  // the smallest identical element, and only that
+      if (same(b, t)) {
+        REQUIRE(r <= b);
+        break;
+      }
+    for (std::uint32_t b = 0; b < m; b += 5) {
+      REQUIRE(s->divergence(t, b) == s->divergence(r, b));
+      REQUIRE(s->divergence(b, t) == s->divergence(b, r));
+    }
+    const double bound = s->mutual_information_lower_bound(t), mi = s->mutual_information(t);
+    REQUIRE(bound <= mi + 1e-12);
+    positive_bounds += bound > 0.1;
+  }
+  REQUIRE(shared > 0);
+  REQUIRE(shared < m);
+  REQUIRE(positive_bounds > m / 4);
 }
 
 TEST_CASE("stretch binned rows approach exact rows as K grows", "[cluster][stretch]") {

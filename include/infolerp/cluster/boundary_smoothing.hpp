@@ -21,7 +21,6 @@
 #include <functional>
 #include <iterator>
 #include <limits>
-#include <queue>
 #include <span>
 #include <utility>
 #include <vector>
@@ -54,8 +53,12 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
 // Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
-// plus O(band · log band); divergences only for the boundary and band triangles.
-// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call).
+// plus O(band · log band); divergences only for the boundary and band triangles, each
+// JS(class, seed) once per set when clusters × classes <= 2^20 (else once per pair), once per
+// representative when the state has representative().
+// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
+// 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
+// per-pair buffers are reused from pair to pair.
 template <class S, class M>
 std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, std::span<const std::uint32_t> triangles,
                                 double threshold, region_growing_result& r) {
@@ -89,10 +92,26 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
 
   std::uint32_t moved = 0;
   std::vector<std::uint32_t> region(n, invalid_id), stack, members;
-  // JS to the pair's two seeds, memoised per class for the current pair.
+  // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
+  std::vector<std::uint64_t> boundary, edges, path;
+  std::vector<std::uint32_t> frontier, ends, endpoints, band, verts, adj_offsets, adj, from;
+  std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
+  std::vector<std::uint8_t> in_band(n, 0);           // all 0 between pairs
+  std::vector<glm::dvec3> pos;
+  std::vector<double> dist;
+  using item = std::pair<double, std::uint32_t>;
+  std::vector<item> heap;
+  // A 2^16-bit filter of the path's edge keys, so the split's flood fill rarely needs the
+  // binary search in `path` (all 0 between pairs; allocated at the first split tried).
+  std::vector<std::uint64_t> path_filter;
+  auto filter_bit = [](std::uint64_t key) { return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 48); };
+  // JS(class, seed of a cluster), memoised per (cluster, class) over all pairs when
+  // clusters × classes <= 2^20 (binned direct channels), else per (side of the pair, class)
+  // for the current pair only (an entry is valid when its stamp is `valid`).
   const std::size_t u = s.class_count();
-  std::vector<double> js_a(u), js_b(u);
-  std::vector<std::uint32_t> stamp(u, invalid_id);
+  const bool dense = std::size_t{k} * u <= (std::size_t{1} << 20);
+  std::vector<double> js((dense ? k : 2) * u);
+  std::vector<std::uint32_t> stamp(js.size(), 0);
   std::uint32_t pair_index = 0;
   for (const auto& pair : pairs) {
     // Plain variables, not a structured binding: the lambda below captures them, which
@@ -103,8 +122,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
                std::back_inserter(members));
     // 1. Boundary edges and the triangles on them.
-    std::vector<std::uint64_t> boundary;
-    std::vector<std::uint32_t> frontier;
+    boundary.clear();
+    frontier.clear();
     for (std::uint32_t i : members) {
       const std::uint32_t other = label[i] == ca ? cb : ca;
       bool on = false;
@@ -117,9 +136,9 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     }
     std::sort(boundary.begin(), boundary.end());
     boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
-    std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
+    degree.clear();
     {
-      std::vector<std::uint32_t> ends;
+      ends.clear();
       for (auto e : boundary) {
         ends.push_back(static_cast<std::uint32_t>(e >> 32));
         ends.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
@@ -132,7 +151,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         i = j;
       }
     }
-    std::vector<std::uint32_t> endpoints;
+    endpoints.clear();
     bool simple = degree.size() == boundary.size() + 1;
     for (const auto& [v, d] : degree) {
       if (d == 1) endpoints.push_back(v);
@@ -141,19 +160,23 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (!simple || endpoints.size() != 2) continue;
 
     // 2. The band.
-    const std::uint32_t seed_a = s.class_of(r.seeds[ca]), seed_b = s.class_of(r.seeds[cb]);
-    const std::uint32_t cluster_a = ca;  // clang++ 14 cannot capture a structured binding
-    auto prefers_other = [&](std::uint32_t i) {
-      const std::uint32_t c = s.class_of(i);
-      if (stamp[c] != pair_index) {
-        stamp[c] = pair_index;
-        js_a[c] = s.divergence(c, seed_a);
-        js_b[c] = s.divergence(c, seed_b);
+    const std::uint32_t cluster_a = ca, cluster_b = cb;  // clang++ 14 cannot capture a structured binding
+    const std::uint32_t valid = dense ? 1u : pair_index;
+    auto js_to = [&](std::uint32_t c, std::uint32_t cluster, std::uint32_t side) {
+      const std::size_t e = (dense ? cluster : side) * u + c;
+      if (stamp[e] != valid) {
+        stamp[e] = valid;
+        js[e] = s.divergence(c, s.class_of(r.seeds[cluster]));
       }
-      return label[i] == cluster_a ? js_b[c] < js_a[c] : js_a[c] < js_b[c];
+      return js[e];
     };
-    std::vector<std::uint8_t> in_band(n, 0);
-    std::vector<std::uint32_t> band;
+    auto prefers_other = [&](std::uint32_t i) {
+      std::uint32_t c = s.class_of(i);
+      if constexpr (detail::has_representative<S>) c = s.representative(c);  // bit-identical JS
+      const double js_a = js_to(c, cluster_a, 0), js_b = js_to(c, cluster_b, 1);
+      return label[i] == cluster_a ? js_b < js_a : js_a < js_b;
+    };
+    band.clear();
     for (std::uint32_t i : frontier)
       if (prefers_other(i)) {
         in_band[i] = 1;
@@ -165,7 +188,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
           in_band[j] = 1;
           band.push_back(j);
         }
-    std::vector<std::uint64_t> edges(boundary);
+    for (std::uint32_t i : band) in_band[i] = 0;
+    edges.assign(boundary.begin(), boundary.end());
     for (std::uint32_t i : band)
       for (int c = 0; c < 3; ++c) {
         const std::uint64_t key = detail::edge_key(tri[i][c], tri[i][(c + 1) % 3]);
@@ -183,7 +207,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (edges.size() == boundary.size()) continue;  // nothing to choose from
 
     // 3. A* between the end vertices over the band edges.
-    std::vector<std::uint32_t> verts;
+    verts.clear();
     for (auto e : edges) {
       verts.push_back(static_cast<std::uint32_t>(e >> 32));
       verts.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
@@ -193,40 +217,59 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     auto vid = [&](std::uint32_t v) {
       return static_cast<std::uint32_t>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
     };
-    std::vector<std::vector<std::uint32_t>> adj(verts.size());
+    // Adjacency (CSR, each vertex's neighbours in `edges` order).
+    adj_offsets.assign(verts.size() + 1, 0);
+    adj.resize(2 * edges.size());
+    for (auto e : edges) {
+      ++adj_offsets[vid(static_cast<std::uint32_t>(e >> 32)) + 1];
+      ++adj_offsets[vid(static_cast<std::uint32_t>(e & 0xffffffffu)) + 1];
+    }
+    for (std::size_t i = 0; i < verts.size(); ++i) adj_offsets[i + 1] += adj_offsets[i];
+    from.assign(adj_offsets.begin(), adj_offsets.end() - 1);  // fill cursors, reused below
     for (auto e : edges) {
       const std::uint32_t a = vid(static_cast<std::uint32_t>(e >> 32)), b = vid(static_cast<std::uint32_t>(e & 0xffffffffu));
-      adj[a].push_back(b);
-      adj[b].push_back(a);
+      adj[from[a]++] = b;
+      adj[from[b]++] = a;
     }
-    std::vector<glm::dvec3> pos(verts.size());
+    pos.resize(verts.size());
     for (std::size_t i = 0; i < verts.size(); ++i) pos[i] = glm::dvec3(mesh_position(m, verts[i]));
     const std::uint32_t start = vid(endpoints[0]), goal = vid(endpoints[1]);
-    std::vector<double> dist(verts.size(), std::numeric_limits<double>::infinity());
-    std::vector<std::uint32_t> from(verts.size(), invalid_id);
-    using item = std::pair<double, std::uint32_t>;
-    std::priority_queue<item, std::vector<item>, std::greater<item>> open;
+    dist.assign(verts.size(), std::numeric_limits<double>::infinity());
+    from.assign(verts.size(), invalid_id);
+    // Open list: a min-heap on (f, vertex) in `heap`.
+    auto push = [&](double f, std::uint32_t v) {
+      heap.emplace_back(f, v);
+      std::push_heap(heap.begin(), heap.end(), std::greater<item>{});
+    };
+    heap.clear();
     dist[start] = 0.0;
-    open.emplace(glm::distance(pos[start], pos[goal]), start);
-    while (!open.empty()) {
-      const auto [f, v] = open.top();
-      open.pop();
+    push(glm::distance(pos[start], pos[goal]), start);
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end(), std::greater<item>{});
+      const auto [f, v] = heap.back();
+      heap.pop_back();
       if (v == goal) break;
       if (f > dist[v] + glm::distance(pos[v], pos[goal])) continue;  // stale entry
-      for (std::uint32_t w : adj[v]) {
+      for (std::uint32_t slot = adj_offsets[v]; slot < adj_offsets[v + 1]; ++slot) {
+        const std::uint32_t w = adj[slot];
         const double d = dist[v] + glm::distance(pos[v], pos[w]);
         if (d < dist[w]) {
           dist[w] = d;
           from[w] = v;
-          open.emplace(d + glm::distance(pos[w], pos[goal]), w);
+          push(d + glm::distance(pos[w], pos[goal]), w);
         }
       }
     }
     if (from[goal] == invalid_id) continue;
-    std::vector<std::uint64_t> path;
+    path.clear();
     for (std::uint32_t v = goal; v != start; v = from[v]) path.push_back(detail::edge_key(verts[v], verts[from[v]]));
     std::sort(path.begin(), path.end());
     if (path == boundary) continue;
+    if (path_filter.empty()) path_filter.assign(1024, 0);
+    for (auto e : path) path_filter[filter_bit(e) >> 6] |= std::uint64_t{1} << (filter_bit(e) & 63);
+    auto on_path = [&](std::uint64_t e) {
+      return (path_filter[filter_bit(e) >> 6] >> (filter_bit(e) & 63) & 1) && std::binary_search(path.begin(), path.end(), e);
+    };
 
     // 4. Split A ∪ B along the path.
     std::uint32_t regions = 0;
@@ -240,7 +283,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
           const std::uint32_t j = g.neighbours[slot];
           if (region[j] != invalid_id || (label[j] != ca && label[j] != cb)) continue;
-          if (slot_edge[slot] != no_edge && std::binary_search(path.begin(), path.end(), slot_edge[slot])) continue;
+          if (slot_edge[slot] != no_edge && on_path(slot_edge[slot])) continue;
           region[j] = regions;
           stack.push_back(j);
         }
@@ -261,6 +304,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
       for (std::uint32_t i : members) members_of[label[i]].push_back(i);
     }
     for (std::uint32_t i : members) region[i] = invalid_id;
+    for (auto e : path) path_filter[filter_bit(e) >> 6] = 0;
   }
   return moved;
 }

@@ -42,6 +42,10 @@ namespace infolerp {
 //   all_alike() -> bool: every row is identical (the clustering then skips all work)
 //   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th (false
 //       may mean either); growth then needs the exact JS only where two seeds claim an element
+//   mutual_information_lower_bound(c) -> double: <= mutual_information(c) up to 1e-9; the first
+//       seed then evaluates MI only for classes whose bound can reach the smallest MI
+//   representative(c) -> class r <= c whose divergences to every class are bit-identical to
+//       c's (r == c when none); JS columns and smoothing memos are then shared within a group
 // Thread-safety: const members are called concurrently from the executor's threads.
 template <class S>
 concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {
@@ -93,8 +97,10 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 //
 // Kernel requirements: class_count(), count(c) (elements in class c, as double),
 //   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
-// Allocation: O(U) at construction; divergence(), divergences() and mutual_information() build
-// rows in per-thread scratch buffers (2U doubles per thread, allocated once and reused).
+// Allocation: U² doubles at construction when U <= max_stored_rows (256, 512 KB): the rows built
+// for Eq. (1) are kept and divergence(), divergences() and mutual_information() read them;
+// above that O(U), and those build rows in per-thread scratch buffers (2U doubles per thread,
+// allocated once and reused).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
@@ -103,15 +109,19 @@ class direct_channel_state {
       : class_of_(std::move(class_of)), kernel_(std::move(kernel)) {
     const std::size_t u = kernel_.class_count();
     output_.assign(u, 0.0);
-    std::vector<double> r(u);
+    if (u <= max_stored_rows) rows_.resize(u * u);
+    std::vector<double> scratch_row(rows_.empty() ? u : 0);
     const double m = static_cast<double>(class_of_.size());
     // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U²).
     for (std::uint32_t a = 0; a < u; ++a) {
+      const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * u, u);
       row(a, r);
       const double w = kernel_.count(a) / m;
       for (std::size_t c = 0; c < u; ++c) output_[c] += w * r[c];
     }
   }
+  // Up to this many classes the rows built for Eq. (1) are kept (U² doubles, 512 KB at most).
+  static constexpr std::size_t max_stored_rows = 256;
 
   std::size_t element_count() const { return class_of_.size(); }
   std::size_t class_count() const { return kernel_.class_count(); }
@@ -131,36 +141,35 @@ class direct_channel_state {
     }
   }
 
-  double mutual_information(std::uint32_t a) const {
-    const std::span<double> r = scratch(0);
-    row(a, r);
-    return element_mutual_information(r, output_);
-  }
+  double mutual_information(std::uint32_t a) const { return element_mutual_information(row_of(a, 0), output_); }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
-    const std::span<double> ra = scratch(0), rb = scratch(1);
-    row(a, ra);
-    row(b, rb);
-    return js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5);
+    return js_divergence(row_of(a, 0), row_of(b, 1), 0.5);
   }
 
   // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
   void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
-    const std::span<double> ra = scratch(0), rb = scratch(1);
-    row(a, ra);
+    const std::span<const double> ra = row_of(a, 0);
     for (std::size_t i = 0; i < out.size(); ++i) {
       const auto b = static_cast<std::uint32_t>(first + i);
       if (b == a) {
         out[i] = 0.0f;
         continue;
       }
-      row(b, rb);
-      out[i] = static_cast<float>(js_divergence(std::span<const double>(ra), std::span<const double>(rb), 0.5));
+      out[i] = static_cast<float>(js_divergence(ra, row_of(b, 1), 0.5));
     }
   }
 
  private:
+  // The row of class a: stored, or built in scratch row `which` (0 or 1).
+  std::span<const double> row_of(std::uint32_t a, std::size_t which) const {
+    const std::size_t u = class_count();
+    if (!rows_.empty()) return {rows_.data() + a * u, u};
+    const std::span<double> r = scratch(which);
+    row(a, r);
+    return r;
+  }
   // Scratch row `which` (0 or 1) of class_count() doubles, per thread.
   std::span<double> scratch(std::size_t which) const {
     thread_local std::vector<double> buffers[2];
@@ -172,6 +181,7 @@ class direct_channel_state {
   std::vector<std::uint32_t> class_of_;
   Kernel kernel_;
   std::vector<double> output_;
+  std::vector<double> rows_;  // U × U when U <= max_stored_rows, else empty
 };
 
 }  // namespace infolerp

@@ -10,10 +10,14 @@
 //   Th = 1, or all rows alike   one cluster per connected component, no divergence evaluated.
 //   seeds        first: the class with minimum I(x;Y); next: the class with maximum summed JS
 //                to the seeds so far among those with JS > Th to every seed; stop when none.
+//                With the state's mutual_information_lower_bound, MI is evaluated only where
+//                the bound is within 1e-9 of the MI of the class of smallest bound.
 //                Lazy: a seed's JS is evaluated (in parallel) only for the classes still
 //                candidates, and during growth only where its frontier arrives, once per
 //                (seed, class); with the state's surely_within, growth evaluates it exactly
-//                only where two seeds claim an element in the same ring. Same result.
+//                only where two seeds claim an element in the same ring. With the state's
+//                representative(), an entry whose representative is evaluated in the same
+//                batch is copied from it (bit-identical). Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
@@ -88,6 +92,19 @@ namespace detail {
 // "JS <= Th − 1e-9 by the state's surely_within, value not evaluated".
 inline constexpr float js_unknown = -1.0f;
 inline constexpr float js_bounded = -3.0f;
+// Transient marks inside one js_entries call (and growth's batch): to evaluate, to copy.
+inline constexpr float js_pending = -2.0f;
+inline constexpr float js_copy = -4.0f;
+
+template <class S>
+concept has_mutual_information_lower_bound = requires(const S& s, std::uint32_t a) {
+  { s.mutual_information_lower_bound(a) } -> std::convertible_to<double>;
+};
+
+template <class S>
+concept has_representative = requires(const S& s, std::uint32_t a) {
+  { s.representative(a) } -> std::convertible_to<std::uint32_t>;
+};
 
 template <class S>
 concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
@@ -101,9 +118,23 @@ concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
 template <class S, class E>
 void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, std::span<float> col, std::size_t grain,
                 E& exec, double threshold = -1.0) {
+  // With the state's representative(): a class whose representative is also listed (and is
+  // neither a nor the class itself) is marked js_copy and copies its entry afterwards
+  // (bit-identical: same row). Representatives are never copies.
+  if constexpr (has_representative<S>) {
+    for (std::uint32_t c : which) col[c] = js_pending;
+    for (std::uint32_t c : which) {
+      const std::uint32_t r = s.representative(c);
+      if (r != c && r != a && c != a && col[r] == js_pending) col[c] = js_copy;
+    }
+  }
   for_each_chunk(exec, which.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e;) {
       const std::uint32_t c = which[i];
+      if (col[c] == js_copy) {
+        ++i;
+        continue;
+      }
       if constexpr (has_surely_within<S>) {
         col[c] = threshold >= 0.0 && s.surely_within(a, c, threshold) ? js_bounded : static_cast<float>(s.divergence(a, c));
         ++i;
@@ -118,6 +149,9 @@ void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> whic
       }
     }
   });
+  if constexpr (has_representative<S>)
+    for (std::uint32_t c : which)
+      if (col[c] == js_copy) col[c] = col[s.representative(c)];
 }
 
 // Renumbers clusters by their smallest element and drops empty ids; seeds follow.
@@ -156,9 +190,23 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
   static_assert(channel_state<S>);
   const std::size_t u = s.class_count();
   std::vector<double> mi(u);
-  for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information(static_cast<std::uint32_t>(c));
-  });
+  if constexpr (detail::has_mutual_information_lower_bound<S>) {
+    // MI only where the bound allows it to reach the MI of the class of smallest bound (all
+    // classes of minimum MI among them); the others get +inf, which cannot be the minimum.
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information_lower_bound(static_cast<std::uint32_t>(c));
+    });
+    const auto lowest = static_cast<std::uint32_t>(std::min_element(mi.begin(), mi.end()) - mi.begin());
+    const double reach = s.mutual_information(lowest) + 1e-9;
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c)
+        mi[c] = mi[c] <= reach ? s.mutual_information(static_cast<std::uint32_t>(c)) : std::numeric_limits<double>::infinity();
+    });
+  } else {
+    for_each_chunk(exec, u, grain, [&](std::size_t, std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) mi[c] = s.mutual_information(static_cast<std::uint32_t>(c));
+    });
+  }
   std::uint32_t next = 0;
   for (std::uint32_t c = 1; c < u; ++c)
     if (mi[c] < mi[next]) next = c;
@@ -247,7 +295,6 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   std::vector<float> best_js(m, std::numeric_limits<float>::infinity());
   std::vector<std::uint32_t> best_k(m, invalid_id), touched;
   std::vector<std::vector<std::uint32_t>> missing(k0);  // column entries this ring needs
-  constexpr float js_pending = -2.0f;
   for (bool any = true; any;) {
     touched.clear();
     for (std::uint32_t k = 0; k < k0; ++k) {
@@ -255,7 +302,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f))
           if (label[n] == invalid_id && columns[k][cls[n]] == detail::js_unknown) {
-            columns[k][cls[n]] = js_pending;
+            columns[k][cls[n]] = detail::js_pending;
             missing[k].push_back(cls[n]);
           }
       std::sort(missing[k].begin(), missing[k].end());

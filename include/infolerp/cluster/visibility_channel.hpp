@@ -17,15 +17,19 @@
 // Denoising (§3.2.1, on by default): each row is replaced by the mean of the rows of itself and
 // its edge neighbours in the set with JS <= Th (most tests are decided by an upper bound on JS
 // without logarithms, see visibility_state::surely_within).
+// Rows that are bit-identical (row and p(t)) after denoising share their divergences through
+// visibility_state::representative (69k groups for 89k triangles on refined_elephant).
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
 // OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -118,6 +122,9 @@ class visibility_state {
   std::span<const float> row(std::uint32_t t) const { return {rows_.data() + std::size_t{t} * n_, n_}; }
   double input_probability(std::uint32_t t) const { return p_[t]; }
   bool unseen(std::uint32_t t) const { return !(p_[t] > 0.0); }
+  // The smallest element whose row and p(t) are bit-identical to t's (t itself when none):
+  // every divergence from it is bit-identical to t's, so JS columns and memos are shared.
+  std::uint32_t representative(std::uint32_t t) const { return rep_[t]; }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
@@ -131,19 +138,21 @@ class visibility_state {
   // 1-homogeneous, so for p >= q f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·h(π), and
   // symmetrically). The bound must be 1e-9 below the threshold (the kernel is accurate to
   // ~1e-15), so a true answer always agrees with divergence(); false means "not decided".
+  // Σ|p − q| is summed in float (8 lanes, twice the SSE width of doubles) and inflated by
+  // (N + 16)·2⁻²², more than its rounding (at most (N/8 + 4) float ulps, relative).
   // O(N), no allocation.
   bool surely_within(std::uint32_t a, std::uint32_t b, double threshold) const {
     if (a == b || unseen(a) || unseen(b)) return false;
     const float* ra = rows_.data() + std::size_t{a} * n_;
     const float* rb = rows_.data() + std::size_t{b} * n_;
-    double l1[4] = {};  // 4 independent sums
+    float l1[8] = {};  // 8 independent sums
     std::size_t v = 0;
-    for (; v + 4 <= n_; v += 4)
-      for (std::size_t lane = 0; lane < 4; ++lane)
-        l1[lane] += std::abs(static_cast<double>(ra[v + lane]) - static_cast<double>(rb[v + lane]));
-    for (; v < n_; ++v) l1[0] += std::abs(static_cast<double>(ra[v]) - static_cast<double>(rb[v]));
+    for (; v + 8 <= n_; v += 8)
+      for (std::size_t lane = 0; lane < 8; ++lane) l1[lane] += std::abs(ra[v + lane] - rb[v + lane]);
+    for (; v < n_; ++v) l1[0] += std::abs(ra[v] - rb[v]);
+    const double sum = static_cast<double>(((l1[0] + l1[1]) + (l1[2] + l1[3])) + ((l1[4] + l1[5]) + (l1[6] + l1[7])));
     constexpr double h_max = 0.53074;  // > 1/(e·ln 2) = 0.5307378...
-    return h_max * ((l1[0] + l1[1]) + (l1[2] + l1[3])) <= threshold - 1e-9;
+    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 1e-9;
   }
   // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
@@ -153,6 +162,25 @@ class visibility_state {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
     return element_mutual_information(row(t), output_);
   }
+  // A lower bound of mutual_information(t) without logarithms: each bin the kernel sums
+  // (p > 0, q > 0) has p·ln(p/q) >= p − q, so I(t;V) >= log₂e·Σ(p − q) over those bins
+  // (the kernel's rounding, ~1e-15, is far inside the seed search's 1e-9 margin). +inf when
+  // unseen. Most rows of a mesh are far from p(V), so the seed search evaluates few MIs.
+  // O(N), no allocation.
+  double mutual_information_lower_bound(std::uint32_t t) const {
+    if (unseen(t)) return std::numeric_limits<double>::infinity();
+    const float* r = rows_.data() + std::size_t{t} * n_;
+    double sum[4] = {};  // 4 independent sums
+    std::size_t v = 0;
+    auto term = [&](std::size_t i) {
+      const double p = r[i], q = output_[i];
+      return p > 0.0 && q > 0.0 ? p - q : 0.0;
+    };
+    for (; v + 4 <= n_; v += 4)
+      for (std::size_t lane = 0; lane < 4; ++lane) sum[lane] += term(v + lane);
+    for (; v < n_; ++v) sum[0] += term(v);
+    return std::numbers::log2e * ((sum[0] + sum[1]) + (sum[2] + sum[3]));
+  }
 
  private:
   friend struct prepared_visibility_channel;
@@ -160,7 +188,45 @@ class visibility_state {
   std::vector<float> rows_;     // M × N
   std::vector<double> p_;       // p(t)
   std::vector<double> output_;  // p(v)
+  std::vector<std::uint32_t> rep_;  // representative(t)
   bool all_alike_ = false;
+
+  // rep_ by an open-addressing hash table of rows (bit patterns of the row and of p(t)).
+  // O(M·N), allocation O(M).
+  void find_representatives() {
+    const std::size_t m = p_.size();
+    rep_.resize(m);
+    std::size_t size = 1;
+    while (size < 2 * m) size *= 2;
+    std::vector<std::uint32_t> table(size, invalid_id);
+    const std::size_t bytes = n_ * sizeof(float);
+    for (std::uint32_t t = 0; t < m; ++t) {
+      const float* r = rows_.data() + std::size_t{t} * n_;
+      constexpr std::uint64_t k = 0x9E3779B97F4A7C15ull;
+      std::uint64_t h0 = std::bit_cast<std::uint64_t>(p_[t]), h1 = 1, h2 = 2, h3 = 3;  // independent chains
+      std::size_t v = 0;
+      for (; v + 4 <= n_; v += 4) {
+        h0 = (h0 ^ std::bit_cast<std::uint32_t>(r[v])) * k;
+        h1 = (h1 ^ std::bit_cast<std::uint32_t>(r[v + 1])) * k;
+        h2 = (h2 ^ std::bit_cast<std::uint32_t>(r[v + 2])) * k;
+        h3 = (h3 ^ std::bit_cast<std::uint32_t>(r[v + 3])) * k;
+      }
+      for (; v < n_; ++v) h0 = (h0 ^ std::bit_cast<std::uint32_t>(r[v])) * k;
+      const std::uint64_t h = h0 ^ (h1 >> 13) ^ (h2 >> 26) ^ (h3 >> 39);
+      for (std::size_t slot = (h ^ (h >> 29)) & (size - 1);; slot = (slot + 1) & (size - 1)) {
+        const std::uint32_t o = table[slot];
+        if (o == invalid_id) {
+          table[slot] = rep_[t] = t;
+          break;
+        }
+        if (std::bit_cast<std::uint64_t>(p_[o]) == std::bit_cast<std::uint64_t>(p_[t]) &&
+            std::memcmp(rows_.data() + std::size_t{o} * n_, r, bytes) == 0) {
+          rep_[t] = o;
+          break;
+        }
+      }
+    }
+  }
 };
 
 // Visibility measured once for a mesh: visible-sample counts per (triangle, viewpoint).
@@ -179,8 +245,9 @@ struct prepared_visibility_channel {
 
   // Algorithm 1's ch.init(cl): p(t|v), p(t), Bayes inversion, optional denoising.
   // Errors: empty set, id out of range. Complexity O(M·N) (+ O(M·N·degree) denoising, + O(M log M)
-  // to find neighbours in the set when it is under 1/8 of the mesh). Allocation O(M·N) floats
-  // (+ T ids for a set of at least 1/8 of the mesh).
+  // to find neighbours in the set when it is under 1/8 of the mesh, + O(M·N) to find the
+  // representatives). Allocation O(M·N) floats (+ T ids for a set of at least 1/8 of the mesh,
+  // + 3M ids for the representatives and their hash table).
   result<visibility_state> init(std::span<const std::uint32_t> triangles) const {
     const std::size_t m = triangles.size(), n = viewpoints;
     if (m == 0) return make_error(errc::empty_input, no_element, "visibility channel: empty triangle set");
@@ -204,6 +271,7 @@ struct prepared_visibility_channel {
     s.output_.assign(n, 0.0);
     if (active == 0) {  // nothing of the set is seen from anywhere: one class, all alike
       s.all_alike_ = true;
+      s.rep_.assign(m, 0);
       return s;
     }
     const double pv = 1.0 / static_cast<double>(active);
@@ -225,11 +293,8 @@ struct prepared_visibility_channel {
         for (std::size_t v = 0; v < n; ++v) s.rows_[i * n + v] = static_cast<float>(pv * ptv[v] / pt);
     }
     if (denoise && threshold > 0.0) denoise_rows(triangles, s);
-    s.all_alike_ = true;
-    for (std::size_t i = 1; i < m && s.all_alike_; ++i)
-      s.all_alike_ = s.p_[i] == s.p_[0] &&
-                     std::equal(s.rows_.begin() + static_cast<std::ptrdiff_t>(i * n),
-                                s.rows_.begin() + static_cast<std::ptrdiff_t>((i + 1) * n), s.rows_.begin());
+    s.find_representatives();
+    s.all_alike_ = std::all_of(s.rep_.begin(), s.rep_.end(), [](std::uint32_t r) { return r == 0; });
     return s;
   }
 
