@@ -3,7 +3,8 @@
 // per-pixel reference of the first stage.
 //   - the trade-off runs: one frame at each of 2..5 passes (method "ibuffer-K"; one pass is
 //     plain per-pixel evaluation, i.e. the reference), and at 3..5 passes with probes (method
-//     "ibuffer-probe-K": primary hit + sun ray per pixel, AO and soft shadow interpolated), each
+//     "ibuffer-probe-K": a primary ray per pixel, the sun ray where needed, AO and soft shadow
+//     interpolated), each
 //     added to ctx.results;
 //   - the shown frame, at --passes K, or with --passes auto under the pass controller (§4.2,
 //     include/infolerp/upsample/pass_controller.hpp, default frame-time bounds 1/60..1/30 s,
@@ -99,16 +100,21 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
     record("ibuffer-" + std::to_string(p), std::to_string(p) + " passes, " + cluster_note);
   }
 
-  // The trade-off runs with probes (sample_source.hpp): primary hit + sun ray at every pixel,
-  // AO and soft shadow interpolated from the sources that match the pixel's own cluster id.
+  // The trade-off runs with refined probes (sample_source.hpp): a primary ray at every pixel,
+  // the sun ray only where the sources of the pixel's own cluster cannot vouch for its
+  // hard-shadow bit, AO and soft shadow interpolated from those sources.
   {
     support::shader_options po = ctx.shader.options();
     po.ao_rays = 0;
     po.soft_shadow_rays = 0;
+    const support::reference_shader primary_sun(ctx.scene, po);
+    po.hard_shadow = false;
     const support::reference_shader primary(ctx.scene, po);
-    support::demo_probe_source psrc;
+    support::demo_refining_probe_source psrc;
     static_cast<support::demo_ibuffer_source&>(psrc) = src;
     psrc.primary = &primary;
+    psrc.probe_lights = false;
+    psrc.primary_sun = &primary_sun;
     auto pu = upsampler<support::demo_sample>::create(
         w, h, {.passes = probe_first, .max_passes = tradeoff_last, .record_kinds = false, .min_sources = probe_min_sources});
     if (!pu) {
@@ -123,7 +129,7 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
         return false;
       }
       const auto& r = add_result(ctx, "ibuffer-probe-" + std::to_string(p),
-                                 std::to_string(p) + " passes, probes (primary + sun per pixel), " + cluster_note,
+                                 std::to_string(p) + " passes, refined probes (primary per pixel, sun where needed), " + cluster_note,
                                  pu->stats().seconds, pu->stats().evaluated_fraction(), img);
       std::printf("%-16s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
                   ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());

@@ -38,8 +38,10 @@
 //     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 7.9x 56.8 dB, 4 passes 11.6x 53.9 dB, 5 passes 13.9x 49.7 dB
 //     159 ids: 4 passes 12.9x 53.1 dB, 5 passes 15.0x 48.8 dB, 6 passes 15.5x 45.0 dB
 //   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.1x 59.5 dB,
-//     1/4 7.5x 56.0 dB, 1/8 12.0x 53.0 dB, 1/16 14.0x 48.4 dB; the refined probes beat each
-//     of these with less CPU time (5-7% less) and a higher PSNR.
+//     1/4 7.5x 56.0 dB, 1/8 12.0x 53.0 dB, 1/16 14.0x 48.4 dB; in that run the refined probes
+//     beat each with 5-7% less CPU time and a higher PSNR, but on the idle machine
+//     (upsample_1025_jb_idle.csv, least of 5, one process) joint-bilateral is 3-6% faster at
+//     1/4, 1/8 and 1/16 (I-Buffer +0.4, +0.1, +0.4 dB) and ties at 1/2: within noise, a tie.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
 // BM_UpsampleInterpolatedPixel) is 9–14 ns per interpolated pixel, 19 ns with probes, 22 ns
 // with refined probes (the probes included).
