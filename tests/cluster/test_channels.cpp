@@ -216,8 +216,9 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
   REQUIRE(p2->visible == p->visible);
 }
 
-TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][visibility]") {
-  // A bumpy sphere under a roof: rows from alike to disjoint, unseen triangles under a cap.
+// A UV sphere under a roof, 32 viewpoints: rows from alike to disjoint, symmetric rows, and
+// unseen triangles under the cap; the state of the visibility channel on all of it.
+static visibility_state sphere_under_roof_state() {
   indexed_mesh scene = support::make_uv_sphere(16, 10);
   support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
   test::brute_tracer tracer(scene);
@@ -228,14 +229,19 @@ TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][vi
   REQUIRE(p.ok());
   auto s = p->init(all_triangles(scene.triangles.size()));
   REQUIRE(s.ok());
+  return std::move(*s);
+}
+
+TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][visibility]") {
+  const visibility_state s = sphere_under_roof_state();
   std::size_t checked = 0, below = 0;
-  const auto m = static_cast<std::uint32_t>(s->element_count());
+  const auto m = static_cast<std::uint32_t>(s.element_count());
   for (std::uint32_t a = 0; a < m; ++a)
     for (std::uint32_t b = a; b < m; b += 7) {
-      const double js = s->divergence(a, b);
+      const double js = s.divergence(a, b);
       for (double th : {0.0, 0.01, 0.1, 0.48, 0.9, 1.0, js, std::nextafter(js, 0.0), std::nextafter(js, 2.0), js + 1e-10,
                         js - 1e-10, js + 2e-9}) {
-        REQUIRE(s->within(a, b, th) == (js <= th));
+        REQUIRE(s.within(a, b, th) == (js <= th));
         ++checked;
         below += js <= th;
       }
@@ -246,28 +252,18 @@ TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][vi
 }
 
 TEST_CASE("visibility: representatives have bit-identical rows and divergences; MI bound below MI", "[cluster][visibility]") {
-  // The bumpy sphere under a roof again: symmetric rows and unseen triangles give groups.
-  indexed_mesh scene = support::make_uv_sphere(16, 10);
-  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
-  test::brute_tracer tracer(scene);
-  auto topo = build_topology(scene);
-  REQUIRE(topo.ok());
-  serial_executor exec;
-  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
-  REQUIRE(p.ok());
-  auto s = p->init(all_triangles(scene.triangles.size()));
-  REQUIRE(s.ok());
-  const auto m = static_cast<std::uint32_t>(s->element_count());
+  const visibility_state s = sphere_under_roof_state();  // symmetric rows and unseen triangles give groups
+  const auto m = static_cast<std::uint32_t>(s.element_count());
   auto same = [&](std::uint32_t a, std::uint32_t b) {
-    const auto ra = s->row(a), rb = s->row(b);
-    return std::memcmp(ra.data(), rb.data(), ra.size_bytes()) == 0 && s->input_probability(a) == s->input_probability(b);
+    const auto ra = s.row(a), rb = s.row(b);
+    return std::memcmp(ra.data(), rb.data(), ra.size_bytes()) == 0 && s.input_probability(a) == s.input_probability(b);
   };
   std::size_t shared = 0, positive_bounds = 0;
   for (std::uint32_t t = 0; t < m; ++t) {
-    const std::uint32_t r = s->representative(t);
+    const std::uint32_t r = s.representative(t);
     REQUIRE(r <= t);
     REQUIRE(same(r, t));
-    REQUIRE(s->representative(r) == r);
+    REQUIRE(s.representative(r) == r);
     shared += r != t;
     for (std::uint32_t b = 0; b < t; ++b)  // the smallest identical element, and only that
       if (same(b, t)) {
@@ -275,10 +271,10 @@ TEST_CASE("visibility: representatives have bit-identical rows and divergences; 
         break;
       }
     for (std::uint32_t b = 0; b < m; b += 5) {
-      REQUIRE(s->divergence(t, b) == s->divergence(r, b));
-      REQUIRE(s->divergence(b, t) == s->divergence(b, r));
+      REQUIRE(s.divergence(t, b) == s.divergence(r, b));
+      REQUIRE(s.divergence(b, t) == s.divergence(b, r));
     }
-    const double bound = s->mutual_information_lower_bound(t), mi = s->mutual_information(t);
+    const double bound = s.mutual_information_lower_bound(t), mi = s.mutual_information(t);
     REQUIRE(bound <= mi + 1e-12);
     positive_bounds += bound > 0.1;
   }
