@@ -445,6 +445,14 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   check_cell("threshold below 0", "compute_saliency(approx)",
              sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = 0.1}),
              {errc::bad_parameter, "approx_cells_per_sigma"});
+  // Inf cells per σ made the cell size 0 and its coordinates 0/0 = NaN (fuzzer).
+  check_cell("Inf parameter", "compute_saliency(approx)",
+             sal({.method = infolerp::saliency_method::approximate,
+                  .approx_cells_per_sigma = std::numeric_limits<double>::infinity()}),
+             {errc::bad_parameter, "approx_cells_per_sigma inf must be in [0.5, 1e6]"});
+  check_cell("NaN parameter", "compute_saliency(approx)",
+             sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = nan_d}),
+             {errc::bad_parameter, "approx_cells_per_sigma"});
 
   std::vector<double> s(nv, 1.0);
   auto clus = [&](const std::vector<double>& v, infolerp::salient_clustering_options o) {

@@ -117,7 +117,7 @@ struct saliency_options {
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   saliency_method method = saliency_method::exact;  // exact or approximate
-  double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ (>= 0.5)
+  double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ, in [0.5, 1e6]
   std::size_t grain = 1;                           // tiles of 3 × 3 columns (exact), ×256 vertices (approximate) per parallel task
 };
 
@@ -731,7 +731,7 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales, a scale <= 0 or not finite, approx_cells_per_sigma < 0.5, a σ whose square is not a
+// scales, a scale <= 0 or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ whose square is not a
 // normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a
 // mesh whose bounding box has zero diagonal (degenerate_triangle).
 // Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
@@ -749,9 +749,12 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
-  if (opt.method == saliency_method::approximate && !(opt.approx_cells_per_sigma >= 0.5))
+  // Above 1e6 cells per σ (or Inf) the cell size σ / cells can underflow to 0, and 0/0 cell
+  // coordinates are NaN (found by fuzz_saliency); such a setting is meaningless anyway.
+  if (opt.method == saliency_method::approximate &&
+      !(opt.approx_cells_per_sigma >= 0.5 && opt.approx_cells_per_sigma <= 1e6))
     return make_error(errc::bad_parameter, no_element, "approx_cells_per_sigma ", opt.approx_cells_per_sigma,
-                      " must be at least 0.5");
+                      " must be in [0.5, 1e6]");
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
