@@ -52,16 +52,6 @@ struct cheap_refining_source : cheap_source {
     return s;
   }
   bool probe_compatible(const sample& p, const sample& s) const { return p.cluster == s.cluster; }
-  sample interpolate(const sample& p, const sample& a, const sample& b) const {
-    sample s = infolerp::interpolate(p, a, b);
-    s.lights = a.lights;
-    return s;
-  }
-  sample interpolate(const sample& p, const sample& a, const sample& b, const sample& c, const sample& d) const {
-    sample s = infolerp::interpolate(p, a, b, c, d);
-    s.lights = a.lights;
-    return s;
-  }
   sample refine_probe(const sample&, std::uint32_t x, std::uint32_t y) const { return evaluate(x, y); }
 };
 

@@ -156,17 +156,6 @@ struct demo_probe_source : demo_ibuffer_source {
   bool probe_compatible(const demo_sample& p, const demo_sample& s) const {
     return probe_lights ? compatible(p, s) : p.cluster == s.cluster;
   }
-  demo_sample interpolate(const demo_sample& p, const demo_sample& a, const demo_sample& b) const {
-    demo_sample s = infolerp::interpolate(p, a, b);
-    if (!probe_lights) s.lights = a.lights;
-    return s;
-  }
-  demo_sample interpolate(const demo_sample& p, const demo_sample& a, const demo_sample& b, const demo_sample& c,
-                          const demo_sample& d) const {
-    demo_sample s = infolerp::interpolate(p, a, b, c, d);
-    if (!probe_lights) s.lights = a.lights;
-    return s;
-  }
 };
 
 // The same with cheap probes and refinement (refine_probe, sample_source.hpp): probes trace

@@ -190,16 +190,6 @@ struct refining : probing<Inner> {
     return s;
   }
   bool probe_compatible(const sample& p, const sample& s) const { return p.cluster == s.cluster; }
-  sample interpolate(const sample& p, const sample& a, const sample& b) const {
-    sample s = infolerp::interpolate(p, a, b);
-    s.lights = a.lights;
-    return s;
-  }
-  sample interpolate(const sample& p, const sample& a, const sample& b, const sample& c, const sample& d) const {
-    sample s = infolerp::interpolate(p, a, b, c, d);
-    s.lights = a.lights;
-    return s;
-  }
   sample refine_probe(const sample& p, std::uint32_t x, std::uint32_t y) const {
     refinements.fetch_add(1, std::memory_order_relaxed);
     sample s = probing<Inner>::probe(x, y);

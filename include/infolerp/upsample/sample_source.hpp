@@ -142,8 +142,10 @@ template <std::size_t K, bool L>
 }
 
 // With a probe (see the top of this file): the primary-hit part (position, normal, texcoords,
-// cluster, light bits, inv_depth) from the probe, occlusion terms from the sources, weighted by
-// their inv_depth as above (1/2 each when equal) ...
+// cluster, inv_depth) from the probe, light bits from a, occlusion terms from the sources,
+// weighted by their inv_depth as above (1/2 each when equal) ... a's light bits equal the
+// probe's whenever the probe carries them (compatible(probe, a)); a probe that leaves them out
+// (refine_probe) is completed only from sources that agree on them.
 template <std::size_t K, bool L>
 [[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& probe, const surface_sample<K, L>& a,
                                                          const surface_sample<K, L>& b) noexcept {
@@ -151,6 +153,7 @@ template <std::size_t K, bool L>
   const float r = 1.0f / sum;
   const float ta = a.inv_depth * r, tb = b.inv_depth * r;
   surface_sample<K, L> s = probe;
+  s.lights = a.lights;
   for (std::size_t i = 0; i < K; ++i) s.occlusion[i] = ta * a.occlusion[i] + tb * b.occlusion[i];
   return s;
 }
@@ -164,6 +167,7 @@ template <std::size_t K, bool L>
   const float r = 1.0f / sum;
   const float ta = a.inv_depth * r, tb = b.inv_depth * r, tc = c.inv_depth * r, td = d.inv_depth * r;
   surface_sample<K, L> s = probe;
+  s.lights = a.lights;
   for (std::size_t i = 0; i < K; ++i)
     s.occlusion[i] = (ta * a.occlusion[i] + tb * b.occlusion[i]) + (tc * c.occlusion[i] + td * d.occlusion[i]);
   return s;
