@@ -98,9 +98,9 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 // Kernel requirements: class_count(), count(c) (elements in class c, as double),
 //   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
 // Allocation: U² doubles at construction when U <= max_stored_rows (256, 512 KB): the rows built
-// for Eq. (1) are kept and divergence(), divergences() and mutual_information() read them;
-// above that O(U), and those build rows in per-thread scratch buffers (2U doubles per thread,
-// allocated once and reused).
+// for Eq. (1) are kept and divergence(), divergences() and mutual_information() read them
+// without allocating; above that O(U), and those build their rows in up to 2U doubles per call
+// (small next to the O(U) work of building a row; no state is kept between calls).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
@@ -141,41 +141,39 @@ class direct_channel_state {
     }
   }
 
-  double mutual_information(std::uint32_t a) const { return element_mutual_information(row_of(a, 0), output_); }
+  double mutual_information(std::uint32_t a) const {
+    std::vector<double> buf;
+    return element_mutual_information(row_of(a, buf), output_);
+  }
 
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
-    return js_divergence(row_of(a, 0), row_of(b, 1), 0.5);
+    std::vector<double> buf_a, buf_b;
+    return js_divergence(row_of(a, buf_a), row_of(b, buf_b), 0.5);
   }
 
   // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
   void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
-    const std::span<const double> ra = row_of(a, 0);
+    std::vector<double> buf_a, buf_b;
+    const std::span<const double> ra = row_of(a, buf_a);
     for (std::size_t i = 0; i < out.size(); ++i) {
       const auto b = static_cast<std::uint32_t>(first + i);
       if (b == a) {
         out[i] = 0.0f;
         continue;
       }
-      out[i] = static_cast<float>(js_divergence(ra, row_of(b, 1), 0.5));
+      out[i] = static_cast<float>(js_divergence(ra, row_of(b, buf_b), 0.5));
     }
   }
 
  private:
-  // The row of class a: stored, or built in scratch row `which` (0 or 1).
-  std::span<const double> row_of(std::uint32_t a, std::size_t which) const {
+  // The row of class a: stored, or built into buf (resized to U on first use).
+  std::span<const double> row_of(std::uint32_t a, std::vector<double>& buf) const {
     const std::size_t u = class_count();
     if (!rows_.empty()) return {rows_.data() + a * u, u};
-    const std::span<double> r = scratch(which);
-    row(a, r);
-    return r;
-  }
-  // Scratch row `which` (0 or 1) of class_count() doubles, per thread.
-  std::span<double> scratch(std::size_t which) const {
-    thread_local std::vector<double> buffers[2];
-    std::vector<double>& b = buffers[which];
-    if (b.size() < class_count()) b.resize(class_count());
-    return {b.data(), class_count()};
+    buf.resize(u);
+    row(a, buf);
+    return buf;
   }
 
   std::vector<std::uint32_t> class_of_;
