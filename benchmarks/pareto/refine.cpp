@@ -34,6 +34,10 @@
 // 1-4), always_refine_fraction 0.01-0.0002 (NLD_OS 32.36-32.42 dB). Other sizes, same gap
 // sign: NLD_OS final / RND final = 31.66 / 32.79 dB at 160x120, 36.35 / 36.47 at 480x360,
 // 38.41 / 39.23 at 640x480 (NLD_OS at 22%, 10%, 7% of RND's samples).
+// The sweep printed last (RND to completion at point fractions 0.05-1.0; NLD_OS run to budgets
+// 25 samples apart): RND 8,891 samples / 31.49 dB at 0.05, 12,230 / 32.21 at 0.1, 14,428 / 32.37
+// at 0.2, reached by NLD_OS with 1,813 (20.4%), 2,016 (16.5%) and 2,036 (14.1%) samples; from 0.3
+// up RND ends at its floor, 15,014 / 32.43 dB, which NLD_OS never reaches.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -81,7 +85,8 @@ struct run_result {
 
 template <class E>
 run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::vector<glm::vec3>& reference,
-               infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec) {
+               infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec,
+               float rnd_fraction = 1.0f) {
   auto sub = infolerp::subdivision_mesh::build(sc.mesh);
   if (!sub.ok()) {
     std::fprintf(stderr, "%s\n", sub.error().message().c_str());
@@ -92,7 +97,7 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   o.criteria.s_req = s_req;
   o.criteria.batch = 64;
   o.criteria.always_refine_fraction = 0.02f;
-  o.criteria.rnd_point_fraction = 1.0f;
+  o.criteria.rnd_point_fraction = rnd_fraction;
   o.max_shading_samples = budget;
   auto r = infolerp::progressive_refiner::create(std::move(*sub), o);
   const auto shade = [&](const infolerp::shading_point& sp) { return sc.shade(sp.position, sp.triangle); };
@@ -235,6 +240,28 @@ int pareto_refine(int argc, char** argv) {
                   os_psnr, os_final, samples, 100.0 * double(os_final) / double(samples));
       break;
     }
+
+  // RND's final image depends on its point fraction (the paper leaves it open): for each
+  // fraction, RND's final PSNR and samples, and the fewest samples with which NLD_OS (run to
+  // budgets 25 samples apart) reaches that PSNR.
+  std::vector<std::pair<std::size_t, double>> os_fine;
+  for (std::size_t budget = 25;; budget += 25) {
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_os, budget, s_req, exec);
+    os_fine.push_back({rr.report.stage2.shading_samples, rr.psnr2});
+    if (!rr.report.budget_reached) break;
+  }
+  std::printf("RND point fraction sweep (NLD_OS samples to reach RND's final PSNR, goal <= 25%%):\n");
+  std::printf("%10s %12s %10s %14s %8s\n", "fraction", "RND samples", "RND dB", "NLD_OS samples", "ratio");
+  for (float fraction : {0.05f, 0.1f, 0.2f, 0.3f, 0.5f, 0.75f, 1.0f}) {
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::rnd, unlimited, s_req, exec, fraction);
+    const std::size_t rs = rr.report.stage2.shading_samples;
+    const auto reach = std::find_if(os_fine.begin(), os_fine.end(), [&](const auto& p) { return p.second >= rr.psnr2; });
+    if (reach == os_fine.end())
+      std::printf("%10.2f %12zu %10.2f %14s %8s\n", double(fraction), rs, rr.psnr2, "never", "-");
+    else
+      std::printf("%10.2f %12zu %10.2f %14zu %7.1f%%\n", double(fraction), rs, rr.psnr2, reach->first,
+                  100.0 * double(reach->first) / double(rs));
+  }
 
   // Plot: PSNR against shading samples, one line per criterion.
   const std::string gp = stem + ".gp";
