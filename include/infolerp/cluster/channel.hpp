@@ -87,41 +87,45 @@ inline status check_threshold(double threshold, const char* what) {
 // exactly 1 for disjoint rows, and the paper wants Th = 1 to give one cluster).
 inline bool is_similar(double js, double threshold) noexcept { return threshold >= 1.0 || js < threshold; }
 
-// A direct channel (T→T) aggregated over classes. The row of an element of class a over the M
-// elements is constant inside each class c, so it is stored per class as
+// A direct channel (T→T) aggregated over classes. Rows are asked per row class a (elements
+// with identical rows); their entries are per column c, a group of output elements:
 //   row_a(c) = mass(a, c) / Σ_c' mass(a, c')      (mass = summed kernel over c's elements)
+// Exact channels use the row classes as columns: the M-entry row is constant inside each class,
 // and JS over the M-entry rows equals js_divergence over these U-entry rows exactly (each JS
-// term is homogeneous in the entry). Input probabilities are uniform (1/M), so JS weights are ½.
+// term is homogeneous in the entry). Binned channels use C cells as columns: the channel to the
+// cells, whose JS is at most the exact one (data-processing inequality). Input probabilities
+// are uniform (1/M), so JS weights are ½.
 // A row whose masses are all 0 (e.g. a planar patch under orientation: 1 − n·n' = 0
-// everywhere) is taken as uniform over the elements, so all such rows are alike.
+// everywhere) is taken as the column sizes over M, so all such rows are alike.
 //
-// Kernel requirements: class_count(), count(c) (elements in class c, as double),
-//   mass(a, c) >= 0, total(a) = Σ_c mass(a, c).
-// Allocation: U² doubles at construction when U <= max_stored_rows (256, 512 KB): the rows built
-// for Eq. (1) are kept and divergence(), divergences() and mutual_information() read them
-// without allocating; above that O(U), and those build their rows in up to 2U doubles per call
-// (small next to the O(U) work of building a row; no state is kept between calls).
+// Kernel requirements: class_count() (U row classes), count(a) (elements in row class a, as
+//   double), column_count() (C), column_size(c) (elements in column c), mass(a, c) >= 0,
+//   total(a) = Σ_c mass(a, c).
+// Allocation: U·C doubles at construction when U·C <= max_stored_entries (65,536, 512 KB): the
+// rows built for Eq. (1) are kept and divergence(), divergences() and mutual_information() read
+// them without allocating; above that O(U + C), and those build their rows in up to 2C doubles
+// per call (small next to the O(C) work of building a row; no state is kept between calls).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
  public:
   direct_channel_state(std::vector<std::uint32_t> class_of, Kernel kernel)
       : class_of_(std::move(class_of)), kernel_(std::move(kernel)) {
-    const std::size_t u = kernel_.class_count();
-    output_.assign(u, 0.0);
-    if (u <= max_stored_rows) rows_.resize(u * u);
-    std::vector<double> scratch_row(rows_.empty() ? u : 0);
+    const std::size_t u = kernel_.class_count(), c = kernel_.column_count();
+    output_.assign(c, 0.0);
+    if (u * c <= max_stored_entries) rows_.resize(u * c);
+    std::vector<double> scratch_row(rows_.empty() ? c : 0);
     const double m = static_cast<double>(class_of_.size());
-    // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U²).
+    // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U·C).
     for (std::uint32_t a = 0; a < u; ++a) {
-      const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * u, u);
+      const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * c, c);
       row(a, r);
       const double w = kernel_.count(a) / m;
-      for (std::size_t c = 0; c < u; ++c) output_[c] += w * r[c];
+      for (std::size_t j = 0; j < c; ++j) output_[j] += w * r[j];
     }
   }
-  // Up to this many classes the rows built for Eq. (1) are kept (U² doubles, 512 KB at most).
-  static constexpr std::size_t max_stored_rows = 256;
+  // Up to this many row entries (U·C) the rows built for Eq. (1) are kept (512 KB at most).
+  static constexpr std::size_t max_stored_entries = 256 * 256;
 
   std::size_t element_count() const { return class_of_.size(); }
   std::size_t class_count() const { return kernel_.class_count(); }
@@ -130,14 +134,14 @@ class direct_channel_state {
   const Kernel& kernel() const { return kernel_; }
   std::span<const double> output_distribution() const { return output_; }
 
-  // p(Y|a) aggregated per class. Preconditions: out.size() == class_count(). O(U), no allocation.
+  // p(Y|a) per column. Preconditions: out.size() == column_count(). O(C), no allocation.
   void row(std::uint32_t a, std::span<double> out) const {
     const double total = kernel_.total(a);
     const double m = static_cast<double>(class_of_.size());
     if (total > 0.0) {
       for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = kernel_.mass(a, c) / total;
     } else {
-      for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = kernel_.count(c) / m;
+      for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = kernel_.column_size(c) / m;
     }
   }
 
@@ -152,7 +156,7 @@ class direct_channel_state {
     return js_divergence(row_of(a, buf_a), row_of(b, buf_b), 0.5);
   }
 
-  // out[i] = divergence(a, first + i); the row of a is built once. O(U·out.size()).
+  // out[i] = divergence(a, first + i); the row of a is built once. O(C·out.size()).
   void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const {
     std::vector<double> buf_a, buf_b;
     const std::span<const double> ra = row_of(a, buf_a);
@@ -167,11 +171,11 @@ class direct_channel_state {
   }
 
  private:
-  // The row of class a: stored, or built into buf (resized to U on first use).
+  // The row of class a: stored, or built into buf (resized to C on first use).
   std::span<const double> row_of(std::uint32_t a, std::vector<double>& buf) const {
-    const std::size_t u = class_count();
-    if (!rows_.empty()) return {rows_.data() + a * u, u};
-    buf.resize(u);
+    const std::size_t c = kernel_.column_count();
+    if (!rows_.empty()) return {rows_.data() + a * c, c};
+    buf.resize(c);
     row(a, buf);
     return buf;
   }
@@ -179,7 +183,7 @@ class direct_channel_state {
   std::vector<std::uint32_t> class_of_;
   Kernel kernel_;
   std::vector<double> output_;
-  std::vector<double> rows_;  // U × U when U <= max_stored_rows, else empty
+  std::vector<double> rows_;  // U × C when U·C <= max_stored_entries, else empty
 };
 
 }  // namespace infolerp

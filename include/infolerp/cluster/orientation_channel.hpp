@@ -3,20 +3,29 @@
 //   p(t_i|t_j) = (1 − n(t_i)·n(t_j)) / Σ_t (1 − n(t)·n(t_j)),
 // evaluated per class of normals (channel.hpp), never as an M×M matrix.
 //
-// Two evaluations:
-//   exact   (bins = 0): classes are the distinct normals (bitwise); rows over the U distinct
-//           normals are the M-entry rows aggregated without loss. O(U) per row, U <= M.
-//   binned  (bins = K): classes are the occupied cells of an r×r octahedral normal map
-//           (r = floor(√K)). O(U) per row, U <= K + 1.
+// Three evaluations (rows per row class, entries per column; channel.hpp):
+//   exact        (bins = 0): row classes and columns are the distinct normals (bitwise); the
+//                rows are the M-entry rows aggregated without loss. O(U) per row, U <= M.
+//   binned       (bins = K, exact_rows = false): row classes and columns are the occupied cells
+//                of an r×r octahedral normal map (r = floor(√K)). O(C) per row, C <= K + 1.
+//   exact rows   (bins = K, exact_rows = true): row classes are the distinct normals, columns
+//                the occupied cells: the exact channel to the cells. O(C) per row, U rows.
 // Binned error: the kernel is linear in n', so each cell's mass Σ(1 − n·n') = count − n·Σn' is
-// exact; two approximations remain: (1) every triangle of a cell uses the cell's mean normal as
-// its own (angular error up to about half a cell diagonal, ≈ 2.5/√K rad before the octahedral
-// map's up-to-2× area distortion), and (2) the entries inside a cell are taken as equal, which
-// can only lower JS (data-processing inequality). Measured (BM_OrientationChannel, jittered
-// 2304-triangle torus, sampled pairs): mean |ΔJS| 0.021 / 0.011 / 0.0030 / 0.0012 and max
-// 0.10 / 0.042 / 0.023 / 0.0079 for K = 64 / 256 / 1024 / 4096. Rows near a triangle's own
-// normal are small (1 − n·n' ≈ 0), so relative errors there are large; the greedy threshold
-// clustering amplifies them (adjusted Rand index against exact only 0.35–0.63 at Th = 0.02).
+// exact for any row normal n. Per-cell rows add two approximations: (1) every triangle of a cell
+// uses the cell's mean normal as its own (angular error up to about half a cell diagonal,
+// ≈ 2.5/√K rad before the octahedral map's up-to-2× area distortion), and (2) the entries inside
+// a cell are taken as equal, which can only lower JS (data-processing inequality). Exact rows
+// keep only (2). Measured (BM_OrientationChannel, CGAL's fandisk, 12,946 triangles, Th = 0.02,
+// CPU time of init + region growing, load 3.5; exact 1.52 s):
+//   K = 64 / 256 / 1024 / 4096, per-cell rows: mean |ΔJS| 7.9e-3 / 3.5e-3 / 1.7e-3 / 8.5e-4,
+//     adjusted Rand index against exact 0.915 / 0.908 / 0.954 / 0.965, 0.5–3.3 ms;
+//   exact rows: mean |ΔJS| 2.3e-3 / 4.2e-4 / 9.6e-5 / 2.4e-5, ARI 0.976 / 0.994 / 0.997 /
+//     0.9997, 10.5 / 16.1 / 29.4 / 60.4 ms (K = 1024: 52× less time than exact).
+// On the jittered 2304-triangle torus (BM_OrientationChannel_Torus) K = 1024 leaves 786 cells
+// for 2304 normals, no binning regime: exact rows ARI 0.83 at 3× less time, per-cell rows 0.49.
+// Per-cell rows are the fast choice inside Algorithm 1 (refined_elephant with bins = 256: exact
+// rows for orientation and stretch take 0.81 s against 0.30 s, and give 1815 / 3986 clusters
+// after those channels against 1960 / 4248).
 // Degenerate cases: a planar set is one class (all alike: one cluster, no work); a zero-area
 // triangle's normal is (0,0,0) (mesh/geometry.hpp), its own class with a uniform row.
 #include <algorithm>
@@ -37,17 +46,23 @@
 
 namespace infolerp {
 
-// Mass of the orientation kernel per class: count, summed normal, and the class's own normal.
+// Mass of the orientation kernel: per row class its normal and size, per column its size and
+// summed normal (for exact rows and per-cell rows the columns are the row classes).
 struct orientation_kernel {
-  std::vector<double> counts;
-  std::vector<glm::dvec3> sums;  // Σ n over the class
-  std::vector<glm::dvec3> reps;  // the class's normal (exact) or normalised mean (binned)
+  std::vector<double> counts;          // elements per row class
+  std::vector<glm::dvec3> reps;        // the row class's normal (exact) or normalised cell mean
+  std::vector<double> column_counts;   // elements per column
+  std::vector<glm::dvec3> column_sums; // Σ n over the column
   glm::dvec3 total_sum{0.0};
   double elements = 0.0;
 
   std::size_t class_count() const { return counts.size(); }
-  double count(std::uint32_t c) const { return counts[c]; }
-  double mass(std::uint32_t a, std::uint32_t c) const { return std::max(0.0, counts[c] - glm::dot(reps[a], sums[c])); }
+  double count(std::uint32_t a) const { return counts[a]; }
+  std::size_t column_count() const { return column_counts.size(); }
+  double column_size(std::uint32_t c) const { return column_counts[c]; }
+  double mass(std::uint32_t a, std::uint32_t c) const {
+    return std::max(0.0, column_counts[c] - glm::dot(reps[a], column_sums[c]));
+  }
   double total(std::uint32_t a) const { return std::max(0.0, elements - glm::dot(reps[a], total_sum)); }
 };
 
@@ -71,15 +86,19 @@ inline std::uint32_t octahedral_cell(glm::vec3 n, std::uint32_t r) {
 }
 
 // Builds the orientation channel over the given normals (one per element).
-// bins = 0: exact classes (distinct normals); else K = bins octahedral cells.
-// Preconditions: normals unit or (0,0,0). Complexity O(M log M) exact, O(M + K) binned (+ the
-// O(U²) output distribution). Allocation O(M + U).
-inline orientation_state make_orientation_state(std::span<const glm::vec3> normals, std::uint32_t bins) {
+// bins = 0: exact (row classes and columns are the distinct normals). bins = K: the columns are
+// the occupied cells of the octahedral map; exact_rows = false: the rows are per cell too (the
+// cell's mean normal stands for its elements); exact_rows = true: every distinct normal keeps
+// its own row over the cells (U rows of C entries).
+// Preconditions: normals unit or (0,0,0). Complexity O(M log M) with exact classes, O(M + K)
+// per-cell rows (+ the O(U·C) output distribution). Allocation O(M + U + C).
+inline orientation_state make_orientation_state(std::span<const glm::vec3> normals, std::uint32_t bins,
+                                                bool exact_rows = false) {
   const std::size_t m = normals.size();
   std::vector<std::uint32_t> class_of(m);
   orientation_kernel k;
   k.elements = static_cast<double>(m);
-  if (bins == 0) {
+  if (bins == 0 || exact_rows) {
     std::vector<std::uint32_t> order(m);
     std::iota(order.begin(), order.end(), 0u);
     auto less = [&](std::uint32_t a, std::uint32_t b) {
@@ -90,39 +109,44 @@ inline orientation_state make_orientation_state(std::span<const glm::vec3> norma
     for (std::size_t i = 0; i < m; ++i) {
       if (i == 0 || normals[order[i]] != normals[order[i - 1]]) {
         k.counts.push_back(0.0);
-        k.sums.emplace_back(0.0);
+        k.column_sums.emplace_back(0.0);
         k.reps.emplace_back(normals[order[i]]);
       }
       class_of[order[i]] = static_cast<std::uint32_t>(k.counts.size() - 1);
       k.counts.back() += 1.0;
-      k.sums.back() += glm::dvec3(normals[order[i]]);
+      k.column_sums.back() += glm::dvec3(normals[order[i]]);
     }
-  } else {
+    k.column_counts = k.counts;
+  }
+  if (bins > 0) {
     const auto r = std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::sqrt(double(bins))));
-    std::vector<std::uint32_t> cell_class(std::size_t{r} * r + 1, invalid_id);
+    std::vector<std::uint32_t> cell_column(std::size_t{r} * r + 1, invalid_id);
     std::vector<std::uint32_t> cell(m);
     for (std::size_t i = 0; i < m; ++i) {
       cell[i] = octahedral_cell(normals[i], r);
-      cell_class[cell[i]] = 0;
+      cell_column[cell[i]] = 0;
     }
     std::uint32_t u = 0;
-    for (auto& c : cell_class)
+    for (auto& c : cell_column)
       if (c != invalid_id) c = u++;
-    k.counts.assign(u, 0.0);
-    k.sums.assign(u, glm::dvec3(0.0));
+    k.column_counts.assign(u, 0.0);
+    k.column_sums.assign(u, glm::dvec3(0.0));
     for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t c = cell_class[cell[i]];
-      class_of[i] = c;
-      k.counts[c] += 1.0;
-      k.sums[c] += glm::dvec3(normals[i]);
+      const std::uint32_t c = cell_column[cell[i]];
+      k.column_counts[c] += 1.0;
+      k.column_sums[c] += glm::dvec3(normals[i]);
     }
-    k.reps.resize(u);
-    for (std::uint32_t c = 0; c < u; ++c) {
-      const double len = glm::length(k.sums[c]);
-      k.reps[c] = len > 0.0 ? k.sums[c] / len : glm::dvec3(0.0);
+    if (!exact_rows) {
+      for (std::size_t i = 0; i < m; ++i) class_of[i] = cell_column[cell[i]];
+      k.counts = k.column_counts;
+      k.reps.resize(u);
+      for (std::uint32_t c = 0; c < u; ++c) {
+        const double len = glm::length(k.column_sums[c]);
+        k.reps[c] = len > 0.0 ? k.column_sums[c] / len : glm::dvec3(0.0);
+      }
     }
   }
-  for (const auto& s : k.sums) k.total_sum += s;
+  for (const auto& s : k.column_sums) k.total_sum += s;
   return orientation_state(std::move(class_of), std::move(k));
 }
 
@@ -130,6 +154,7 @@ inline orientation_state make_orientation_state(std::span<const glm::vec3> norma
 struct prepared_orientation_channel {
   double threshold = 0.02;
   std::uint32_t bins = 1024;
+  bool exact_rows = false;
   std::vector<glm::vec3> normals;  // per triangle of the mesh
 
   // Algorithm 1's ch.init(cl). Errors: empty set, triangle id out of range.
@@ -143,7 +168,7 @@ struct prepared_orientation_channel {
                           " out of range (", normals.size(), " triangles)");
       n[i] = normals[triangles[i]];
     }
-    return make_orientation_state(n, bins);
+    return make_orientation_state(n, bins, exact_rows);
   }
 };
 
@@ -151,13 +176,14 @@ struct prepared_orientation_channel {
 struct orientation_channel {
   double threshold = 0.02;  // JS threshold Th in [0,1]: 0 = one cluster per triangle, 1 = one cluster
   std::uint32_t bins = 1024;  // K octahedral cells (rounded down to a square); 0 = exact rows
+  bool exact_rows = false;    // with bins > 0: each distinct normal keeps its own row over the cells
 
   // Computes the face normals. Complexity O(T), allocation T normals. Never fails for a valid mesh.
   template <class M, class T, class E>
   result<prepared_orientation_channel> prepare(const M& m, const mesh_topology& /*topo*/, const T& /*tracer*/,
                                                E& /*exec*/) const {
     static_assert(check_mesh<M>());
-    return prepared_orientation_channel{threshold, bins, face_normals(m)};
+    return prepared_orientation_channel{threshold, bins, exact_rows, face_normals(m)};
   }
 };
 
