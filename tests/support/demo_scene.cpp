@@ -35,16 +35,6 @@ pinhole_rays camera::rays() const {
   return r;
 }
 
-ray pinhole_rays::operator()(float x, float y, int width, int height) const {
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * half_h * aspect;
-  const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * half_h;
-  ray r;
-  r.origin = eye;
-  r.direction = glm::normalize(forward + sx * right + sy * true_up);
-  return r;
-}
-
 ray camera::primary_ray(float x, float y, int width, int height) const { return rays()(x, y, width, height); }
 
 glm::vec3 area_light::normal() const { return glm::normalize(glm::cross(edge_u, edge_v)); }

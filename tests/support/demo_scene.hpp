@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 #include <vector>
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/status.hpp"
@@ -22,7 +23,16 @@ namespace infolerp::support {
 struct pinhole_rays {
   glm::vec3 eye{0.0f}, forward{0.0f}, right{0.0f}, true_up{0.0f};
   float half_h = 0.0f;
-  ray operator()(float x, float y, int width, int height) const;
+  // Inline: the upsampler's sources call it once or twice per pixel.
+  ray operator()(float x, float y, int width, int height) const {
+    const float aspect = static_cast<float>(width) / static_cast<float>(height);
+    const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * half_h * aspect;
+    const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * half_h;
+    ray r;
+    r.origin = eye;
+    r.direction = glm::normalize(forward + sx * right + sy * true_up);
+    return r;
+  }
 };
 
 struct camera {

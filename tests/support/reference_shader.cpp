@@ -112,6 +112,19 @@ shading_inputs reference_shader::evaluate_hit(const ray& primary, const hit& h, 
 
   // Secondary rays leave from just above the surface (geometric side facing the camera).
   const glm::vec3 origin = in.position + scene.ray_offset * ng;
+
+  // Hard shadow: one ray toward the sun (none when the surface faces away).
+  if (options_.hard_shadow && glm::dot(ng, scene.sun.direction) > 0.0f) {
+    const ray sun{origin, 0.0f, scene.sun.direction};
+    ++rays;
+    if (count_unoccluded(std::span<const ray>(&sun, 1)) == 1) in.light_bits |= sun_light_bit;
+  }
+  if (light_points_.empty() && hemisphere_.empty()) {  // a primary-only shader: no batch to fill
+    in.ao = 1.0f;
+    return in;
+  }
+
+  // The batch (2 KiB of initialised rays) only for shaders with soft-shadow or AO rays.
   std::array<ray, 64> batch;
   std::size_t count = 0;
   auto flush = [&] {
@@ -120,12 +133,6 @@ shading_inputs reference_shader::evaluate_hit(const ray& primary, const hit& h, 
     count = 0;
     return visible;
   };
-
-  // Hard shadow: one ray toward the sun (none when the surface faces away).
-  if (options_.hard_shadow && glm::dot(ng, scene.sun.direction) > 0.0f) {
-    batch[count++] = ray{origin, 0.0f, scene.sun.direction};
-    if (flush() == 1) in.light_bits |= sun_light_bit;
-  }
 
   // Soft shadow: rays to the fixed light points the surface and the light face each other at.
   if (!light_points_.empty()) {

@@ -28,23 +28,24 @@
 // not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// sun, 2 threads, process CPU time, least of 3 runs, load average 4-5.5; full per-pixel
-// evaluation 3.24 s):
-//   plain, demo thresholds (518 ids):     4 passes 8.8x 45.7 dB, 5 passes 9.5x 44.0 dB
-//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.6x 42.9 dB, 5 passes 13.0x 40.5 dB
-//   probes (primary + sun), 518 ids:      4 passes 10.4x 54.3 dB, 5 passes 12.5x 50.4 dB
-//   probes (primary + sun), 131 ids:      5 passes 13.0x 49.0 dB, 6 passes 13.5x 44.7 dB
+// sun, 2 threads, process CPU time, least of 3 runs, one process, load average 3.3-3.6; full
+// per-pixel evaluation 3.33 s):
+//   plain, demo thresholds (518 ids):     4 passes 8.2x 45.7 dB, 5 passes 8.9x 44.0 dB
+//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.1x 42.9 dB, 5 passes 12.5x 40.5 dB
+//   probes (primary + sun), 518 ids:      4 passes 11.7x 54.3 dB, 5 passes 13.3x 50.4 dB
+//   probes (primary + sun), 131 ids:      5 passes 14.1x 49.0 dB, 6 passes 14.4x 44.7 dB
 //   refined probes (primary, sun where needed), min_sources 1:
-//     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 7.9x 56.8 dB, 4 passes 11.6x 53.9 dB, 5 passes 13.9x 49.7 dB
-//     159 ids: 4 passes 12.9x 53.1 dB, 5 passes 15.0x 48.8 dB, 6 passes 15.5x 45.0 dB
-//   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.1x 59.5 dB,
-//     1/4 7.5x 56.0 dB, 1/8 12.0x 53.0 dB, 1/16 14.0x 48.4 dB; in that run the refined probes
-//     beat each with 5-7% less CPU time and a higher PSNR, but on the idle machine
-//     (upsample_1025_jb_idle.csv, least of 5, one process) joint-bilateral is 3-6% faster at
-//     1/4, 1/8 and 1/16 (I-Buffer +0.4, +0.1, +0.4 dB) and ties at 1/2: within noise, a tie.
+//     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 8.5x 56.8 dB, 4 passes 13.7x 53.9 dB, 5 passes 16.0x 49.7 dB
+//     159 ids: 4 passes 13.8x 53.1 dB, 5 passes 17.1x 48.8 dB, 6 passes 17.8x 45.0 dB
+//   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.0x 59.5 dB,
+//     1/4 7.3x 56.0 dB, 1/8 11.8x 53.0 dB, 1/16 13.8x 48.4 dB; each is beaten by refined probes
+//     with a higher PSNR and 9%, 14%, 15%, 19% less CPU time (518 ids 2 and 3 passes, 159 ids 4
+//     and 5 passes). Before the per-row counters stopped sharing cache lines and the records
+//     stopped being copied whole (run_rows, sample_source.hpp), joint-bilateral was 3-6% faster
+//     at 1/4, 1/8 and 1/16 on the idle machine (upsample_1025_jb_idle.csv).
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
-// BM_UpsampleInterpolatedPixel) is 9–14 ns per interpolated pixel, 19 ns with probes, 22 ns
-// with refined probes (the probes included).
+// BM_UpsampleInterpolatedPixel, load ~3) is 9–15 ns per interpolated pixel, 17 ns with probes,
+// 13 ns with refined probes (the probes included).
 //
 // Determinism: each output row of a pass depends only on the previous pass, so rows run in
 // parallel through the user's executor and the output is identical for any executor and thread
@@ -312,14 +313,19 @@ class upsampler {
     return std::chrono::duration<double>(Clock::now() - start).count();
   }
 
-  // Calls row_fn(j, counts_j) for every row of buffer d through the executor.
+  // Calls row_fn(j, counts) for every row j of buffer d through the executor and stores the
+  // row's counts. They are counted in a local array: counting straight into row_counts_, whose
+  // neighbouring rows share a cache line but run on different threads, was false sharing that
+  // cost ~35 ms CPU of a 0.26 s probe frame when both threads ran at once (perf, demo scene
+  // 1025², 5 passes, 2 threads: probe_row's own time halved).
   template <class E, class F>
   void run_rows(E& exec, std::uint32_t d, const F& row_fn) {
     const std::uint32_t rows = extents_[d][1];
     exec.parallel_for(rows, options_.rows_per_task, [&](std::size_t begin, std::size_t end) {
       for (std::size_t j = begin; j < end; ++j) {
-        row_counts_[j] = {};
-        row_fn(static_cast<std::uint32_t>(j), row_counts_[j]);
+        std::array<std::size_t, 3> counts{};
+        row_fn(static_cast<std::uint32_t>(j), counts);
+        row_counts_[j] = counts;
       }
     });
   }
