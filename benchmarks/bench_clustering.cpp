@@ -28,7 +28,7 @@
 //     ARI 1 at 187x (per-cell rows 0.66): goal met. The jittered torus (2304 triangles, 786
 //     occupied cells) is no binning regime: exact rows ARI 0.83 at 3x; on bunny00 (a scan,
 //     exact 803 s, not benchmarked) exact rows give ARI 0.49 at K = 1024, 0.85 at 4096. Exact
-//     against exact at Th x 1.01: ARI 0.994 on fandisk, 0.72 on the torus.
+//     against exact at Th x 1.01: ARI 0.994 on fandisk, 0.72 on the torus, 0.48 on bunny00.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
