@@ -27,8 +27,8 @@
 // rows give ARI 0.46 / 0.51 / 0.49 / 0.85 at 1,600× / 440× / 111× / 17× less time (per-cell
 // rows 0.32–0.47). How well-posed agreement is depends on the mesh: exact against exact at a
 // threshold 1% higher gives ARI 0.994 on fandisk but 0.72 on the torus (1.0 at 1e-4) and 0.48
-// on bunny00 (as low as binning's 0.49 there), so where
-// clusters have no natural borders a JS error of 1% of Th already moves them.
+// on bunny00 (as low as binning's 0.49 there): where clusters have no natural borders, a JS
+// error of 1% of Th already moves them.
 // Per-cell rows are the fast choice inside Algorithm 1 (refined_elephant with bins = 256: exact
 // rows for orientation and stretch take 0.81 s against 0.30 s, and give 1815 / 3986 clusters
 // after those channels against 1960 / 4248).
