@@ -93,8 +93,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::uint32_t moved = 0;
   std::vector<std::uint32_t> region(n, invalid_id), stack, members;
   // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
-  std::vector<std::uint64_t> boundary, edges, path;
-  std::vector<std::uint32_t> frontier, ends, endpoints, band, verts, adj_offsets, adj, from;
+  std::vector<std::uint64_t> boundary, edges, path, end_keys;
+  std::vector<std::uint32_t> frontier, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
   std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
   std::vector<std::uint8_t> in_band(n, 0);           // all 0 between pairs
   std::vector<glm::dvec3> pos;
@@ -207,27 +207,32 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (edges.size() == boundary.size()) continue;  // nothing to choose from
 
     // 3. A* between the end vertices over the band edges.
-    verts.clear();
-    for (auto e : edges) {
-      verts.push_back(static_cast<std::uint32_t>(e >> 32));
-      verts.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
+    // Local vertex ids, ascending with the mesh ids: the edge ends (vertex in the high half,
+    // end slot 2e or 2e + 1 in the low half) sorted and numbered in one pass.
+    end_keys.clear();
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      end_keys.push_back((edges[e] & ~std::uint64_t{0xffffffffu}) | (2 * e));
+      end_keys.push_back((edges[e] << 32) | (2 * e + 1));
     }
-    std::sort(verts.begin(), verts.end());
-    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    std::sort(end_keys.begin(), end_keys.end());
+    verts.clear();
+    end_vertex.resize(end_keys.size());
+    for (std::uint64_t key : end_keys) {
+      const auto v = static_cast<std::uint32_t>(key >> 32);
+      if (verts.empty() || verts.back() != v) verts.push_back(v);
+      end_vertex[key & 0xffffffffu] = static_cast<std::uint32_t>(verts.size() - 1);
+    }
     auto vid = [&](std::uint32_t v) {
       return static_cast<std::uint32_t>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
     };
     // Adjacency (CSR, each vertex's neighbours in `edges` order).
     adj_offsets.assign(verts.size() + 1, 0);
     adj.resize(2 * edges.size());
-    for (auto e : edges) {
-      ++adj_offsets[vid(static_cast<std::uint32_t>(e >> 32)) + 1];
-      ++adj_offsets[vid(static_cast<std::uint32_t>(e & 0xffffffffu)) + 1];
-    }
+    for (std::uint32_t v : end_vertex) ++adj_offsets[v + 1];
     for (std::size_t i = 0; i < verts.size(); ++i) adj_offsets[i + 1] += adj_offsets[i];
     from.assign(adj_offsets.begin(), adj_offsets.end() - 1);  // fill cursors, reused below
-    for (auto e : edges) {
-      const std::uint32_t a = vid(static_cast<std::uint32_t>(e >> 32)), b = vid(static_cast<std::uint32_t>(e & 0xffffffffu));
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      const std::uint32_t a = end_vertex[2 * e], b = end_vertex[2 * e + 1];
       adj[from[a]++] = b;
       adj[from[b]++] = a;
     }
