@@ -266,10 +266,10 @@ struct prepared_visibility_channel {
     for (double w : weight) active += w > 0.0 ? 1 : 0;
     visibility_state s;
     s.n_ = n;
-    s.rows_.assign(m * n, 0.0f);
     s.p_.assign(m, 0.0);
     s.output_.assign(n, 0.0);
     if (active == 0) {  // nothing of the set is seen from anywhere: one class, all alike
+      s.rows_.assign(m * n, 0.0f);
       s.all_alike_ = true;
       s.rep_.assign(m, 0);
       return s;
@@ -281,6 +281,8 @@ struct prepared_visibility_channel {
     for (std::uint32_t c = 0; c <= samples; ++c)
       for (std::size_t v = 0; v < n; ++v) ptv_of[c * n + v] = weight[v] > 0.0 ? ratio[c] / weight[v] : 0.0;
     std::vector<double> ptv(n);
+    std::vector<float> row(n);
+    s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
     for (std::size_t i = 0; i < m; ++i) {
       const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
       double pt = 0.0;
@@ -289,8 +291,8 @@ struct prepared_visibility_channel {
         pt += pv * ptv[v];
       }
       s.p_[i] = pt;
-      if (pt > 0.0)
-        for (std::size_t v = 0; v < n; ++v) s.rows_[i * n + v] = static_cast<float>(pv * ptv[v] / pt);
+      for (std::size_t v = 0; v < n; ++v) row[v] = pt > 0.0 ? static_cast<float>(pv * ptv[v] / pt) : 0.0f;
+      s.rows_.insert(s.rows_.end(), row.begin(), row.end());
     }
     if (denoise && threshold > 0.0) denoise_rows(triangles, s);
     s.find_representatives();
@@ -320,10 +322,14 @@ struct prepared_visibility_channel {
       const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
       return it != sorted.end() && it->first == t ? it->second : invalid_id;
     };
-    std::vector<float> out(m * n, 0.0f);  // unseen rows stay 0
+    std::vector<float> out, row(n);
+    out.reserve(m * n);  // appended row by row: no M×N zero fill first
     std::vector<double> acc(n);
     for (std::uint32_t i = 0; i < m; ++i) {
-      if (s.unseen(i)) continue;
+      if (s.unseen(i)) {  // stays 0
+        out.insert(out.end(), n, 0.0f);
+        continue;
+      }
       std::fill(acc.begin(), acc.end(), 0.0);
       std::size_t count = 0;
       auto add = [&](std::size_t j) {
@@ -336,7 +342,14 @@ struct prepared_visibility_channel {
         const std::uint32_t j = local_of(neighbours[k]);
         if (j != invalid_id && !s.unseen(j) && s.within(i, j, threshold)) add(j);
       }
-      for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
+      // acc / count; by a power of two as a product by its inverse (the same bits, no division).
+      const auto c = static_cast<double>(count);
+      if ((count & (count - 1)) == 0) {
+        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(acc[v] * (1.0 / c));
+      } else {
+        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(acc[v] / c);
+      }
+      out.insert(out.end(), row.begin(), row.end());
     }
     s.rows_ = std::move(out);
   }
