@@ -52,10 +52,11 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
-// Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
-// plus O(band · log band); divergences only for the boundary and band triangles, each
-// JS(class, seed) once per set when clusters × classes <= 2^20 (else once per pair), once per
-// representative when the state has representative().
+// Preconditions: r from grow_regions(s, g, ...), g symmetric (a dual graph is). Complexity per
+// neighbouring pair: O(min(|A|, |B|)) to find the boundary, O(band · log band) for the band and
+// the path, and O(|A| + |B|) only when a new path is tried (the split). Divergences only for
+// the boundary and band triangles, each JS(class, seed) once per set when clusters × classes
+// <= 2^20 (else once per pair), once per representative when the state has representative().
 // Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
 // 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
 // per-pair buffers are reused from pair to pair.
@@ -94,7 +95,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::vector<std::uint32_t> region(n, invalid_id), stack, members;
   // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
   std::vector<std::uint64_t> boundary, edges, path, end_keys;
-  std::vector<std::uint32_t> frontier, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
+  std::vector<std::uint32_t> frontier, far_side, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
   std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
   std::vector<std::uint8_t> in_band(n, 0);           // all 0 between pairs
   std::vector<glm::dvec3> pos;
@@ -118,22 +119,33 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     // clang before 16 rejects for structured bindings.
     const std::uint32_t ca = pair.first, cb = pair.second;
     ++pair_index;
-    members.clear();
-    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
-               std::back_inserter(members));
-    // 1. Boundary edges and the triangles on them.
+    // 1. Boundary edges (the mesh edges of A's graph slots into B) and the triangles on them,
+    // found from the smaller cluster's side: the graph is symmetric, and a slot has a shared
+    // edge exactly when its reverse slot has one.
+    const bool from_a = members_of[ca].size() <= members_of[cb].size();
+    const std::uint32_t near = from_a ? ca : cb, far = from_a ? cb : ca;
     boundary.clear();
     frontier.clear();
-    for (std::uint32_t i : members) {
-      const std::uint32_t other = label[i] == ca ? cb : ca;
+    far_side.clear();
+    for (std::uint32_t i : members_of[near]) {
       bool on = false;
-      for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot)
-        if (label[g.neighbours[slot]] == other && slot_edge[slot] != no_edge) {
-          if (label[i] == ca) boundary.push_back(slot_edge[slot]);
-          on = true;
+      for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot) {
+        const std::uint32_t j = g.neighbours[slot];
+        if (label[j] != far || slot_edge[slot] == no_edge) continue;
+        on = true;
+        far_side.push_back(j);
+        if (from_a) {
+          boundary.push_back(slot_edge[slot]);
+        } else {  // A's slot back to i, with A's edge key (a triangle may share 3 vertices with i)
+          for (std::uint32_t back = g.offsets[j]; back < g.offsets[j + 1]; ++back)
+            if (g.neighbours[back] == i) boundary.push_back(slot_edge[back]);
         }
+      }
       if (on) frontier.push_back(i);
     }
+    std::sort(far_side.begin(), far_side.end());
+    far_side.erase(std::unique(far_side.begin(), far_side.end()), far_side.end());
+    frontier.insert(frontier.end(), far_side.begin(), far_side.end());
     std::sort(boundary.begin(), boundary.end());
     boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
     degree.clear();
@@ -277,6 +289,9 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     };
 
     // 4. Split A ∪ B along the path.
+    members.clear();
+    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
+               std::back_inserter(members));
     std::uint32_t regions = 0;
     for (std::uint32_t i : members) {
       if (region[i] != invalid_id) continue;
