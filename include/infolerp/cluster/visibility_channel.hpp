@@ -162,24 +162,12 @@ class visibility_state {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
     return element_mutual_information(row(t), output_);
   }
-  // A lower bound of mutual_information(t) without logarithms: each bin the kernel sums
-  // (p > 0, q > 0) has p·ln(p/q) >= p − q, so I(t;V) >= log₂e·Σ(p − q) over those bins
-  // (the kernel's rounding, ~1e-15, is far inside the seed search's 1e-9 margin). +inf when
+  // A lower bound of mutual_information(t) without logarithms (info/entropy.hpp), +inf when
   // unseen. Most rows of a mesh are far from p(V), so the seed search evaluates few MIs.
   // O(N), no allocation.
   double mutual_information_lower_bound(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
-    const float* r = rows_.data() + std::size_t{t} * n_;
-    double sum[4] = {};  // 4 independent sums
-    std::size_t v = 0;
-    auto term = [&](std::size_t i) {
-      const double p = r[i], q = output_[i];
-      return p > 0.0 && q > 0.0 ? p - q : 0.0;
-    };
-    for (; v + 4 <= n_; v += 4)
-      for (std::size_t lane = 0; lane < 4; ++lane) sum[lane] += term(v + lane);
-    for (; v < n_; ++v) sum[0] += term(v);
-    return std::numbers::log2e * ((sum[0] + sum[1]) + (sum[2] + sum[3]));
+    return infolerp::mutual_information_lower_bound(row(t), std::span<const double>(output_));
   }
 
  private:
