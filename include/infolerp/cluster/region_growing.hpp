@@ -91,7 +91,8 @@ struct region_growing_result {
 namespace detail {
 
 // JS column entries that are not a value (JS is never negative): not evaluated (yet), and
-// "JS <= Th − 1e-9 by the state's surely_within, value not evaluated".
+// "JS <= Th − 2⁻²² by the state's surely_within, value not evaluated" (so the float of the
+// value would also be < Th: a bounded entry decides as the exact one would).
 inline constexpr float js_unknown = -1.0f;
 inline constexpr float js_bounded = -3.0f;
 // Transient marks inside one js_entries call (and growth's batch): to evaluate, to copy.

@@ -136,8 +136,10 @@ class visibility_state {
   //   JS_π(P,Q) <= h(π)·Σ_{p>q}(p − q) + h(1 − π)·Σ_{q>p}(q − p) <= h_max·Σ|p − q|,
   // h(x) = −x·log₂x <= h_max = 1/(e·ln 2) ≈ 0.53074 (the per-bin term f(p,q) is convex and
   // 1-homogeneous, so for p >= q f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·h(π), and
-  // symmetrically). The bound must be 1e-9 below the threshold (the kernel is accurate to
-  // ~1e-15), so a true answer always agrees with divergence(); false means "not decided".
+  // symmetrically). The bound must be 2⁻²² below the threshold: more than the kernel's error
+  // (~1e-15) and than the rounding of a JS value to a float column entry (region_growing.hpp),
+  // so a true answer always agrees with divergence() and with that entry; false means "not
+  // decided".
   // Σ|p − q| is summed in float (8 lanes, twice the SSE width of doubles) and inflated by
   // (N + 16)·2⁻²², more than its rounding (at most (N/8 + 4) float ulps, relative).
   // O(N), no allocation.
@@ -152,7 +154,7 @@ class visibility_state {
     for (; v < n_; ++v) l1[0] += std::abs(ra[v] - rb[v]);
     const double sum = static_cast<double>(((l1[0] + l1[1]) + (l1[2] + l1[3])) + ((l1[4] + l1[5]) + (l1[6] + l1[7])));
     constexpr double h_max = 0.53074;  // > 1/(e·ln 2) = 0.5307378...
-    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 1e-9;
+    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 0x1p-22;
   }
   // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
