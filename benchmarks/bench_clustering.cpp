@@ -8,9 +8,11 @@
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
 // Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
-//   BM_Clustering_RefinedElephant   267-286 ms CPU at load 4.6 (6 runs: 286 271 267 281 272 269),
-//     against 294-315 (315 305 302 302 294 300) for the previous version (027c16b, ~251 ms on
-//     one idle core) in the same alternating runs; ~1070 ms before the issue-3 speed work;
+//   BM_Clustering_RefinedElephant   251-266 ms CPU at load 1.8 (6 runs: 260 265 266 255 251 251),
+//     against 278-290 (281 281 290 279 278 282) for the previous version (027c16b, which
+//     measured ~251 ms on one idle core) in the same alternating runs, so ~227 ms idle
+//     expected (clang++ 14: 256 / 251 / 252 at load 1.7); at load 4.6 267-286 against
+//     294-315; ~1070 ms before the issue-3 speed work;
 //     clusters identical throughout (34 / 1960 / 4248, hash of cluster_of unchanged). Goal
 //     <= 150 ms NOT met. CPU per channel (load 4.75, so inflated): visibility ~180 (incl.
 //     validation and topology), orientation ~37-44, stretch ~41-43. Visibility JS evaluations
