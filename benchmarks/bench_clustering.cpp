@@ -11,17 +11,22 @@
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
 // Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
-//   BM_Clustering_RefinedElephant   ~250 ms at load 2.3 (251 / 252; clang++ 14: 243 / 250) and
-//     ~270 ms at load 4.7 (265 / 272 / 271); the previous version (merge fe8850b) measured
-//     295 / 301 and 319 / 320 / 322 in the same alternating runs, ~1070 ms before the issue-3
-//     speed work; clusters identical
-//     throughout (34 / 1960 / 4248). Goal <= 150 ms NOT met. CPU per call (thread CPU time,
-//     load 4.8, so inflated): visibility ~172 (init + denoising ~47, seeds and growth ~68,
-//     boundary smoothing ~57), orientation ~40 (growth 14, smoothing 24), stretch ~35 (growth
-//     19, smoothing 9, init with texture stretch 6). Visibility JS evaluations (64 bins):
-//     seed search 173k, growth 52k, smoothing 73k (from 220k / 50k / 90k: bit-identical rows
-//     share their JS, 69k groups for 89k rows); I(t;V) evaluated for ~1k rows (from 89k: a
-//     log-free lower bound rules the rest out); denoising decides nearly all its tests by a bound.
+//   BM_Clustering_RefinedElephant   251-266 ms CPU at load 1.8 (6 runs: 260 265 266 255 251 251),
+//     against 278-290 (281 281 290 279 278 282) for the previous version (027c16b, which
+//     measured ~251 ms on one idle core) in the same alternating runs, so ~227 ms idle
+//     expected (clang++ 14: 256 / 251 / 252 at load 1.7); at load 4.6 267-286 against
+//     294-315; ~1070 ms before the issue-3 speed work;
+//     clusters identical throughout (34 / 1960 / 4248, hash of cluster_of unchanged). Goal
+//     <= 150 ms NOT met. CPU per channel (load 4.75, so inflated): visibility ~180 (incl.
+//     validation and topology), orientation ~37-44, stretch ~41-43. Visibility JS evaluations
+//     (64 bins, ~160 ns each by BM_JensenShannon*; the kernel divides 3 times per bin): seed
+//     search 149k (+25k decided by surely_within, from 173k exact), growth 32k (+27k bounded,
+//     from 52k), smoothing 73k (63.5k distinct (class, cluster) pairs, so a memo across pairs
+//     would save little); bit-identical rows share their JS (69k groups for 89k rows); I(t;V)
+//     evaluated for ~1k rows (a vectorised log-free lower bound rules the rest out); denoising
+//     decides nearly all its tests by a bound. By profile (load ~4) the JS kernel on float
+//     rows is ~16% of the run, on the direct channels' double rows ~6%, smoothing's own work
+//     ~10%.
 //   Direct channels at K = 1024 (CPU, load 3.5; every figure in orientation_channel.hpp and
 //     stretch_channel.hpp): orientation on fandisk, exact rows ARI 0.997 at 52x less time than
 //     exact (29 ms against 1.52 s; per-cell rows 0.954); stretch on the UV sphere, exact rows

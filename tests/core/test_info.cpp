@@ -308,3 +308,20 @@ TEST_CASE("entropy checked variants: errors") {
   CHECK(checked(infolerp::checked_mutual_information(std::vector<double>{2.0, 2.0}, std::vector<double>{5.0, 0.0, 0.0, 3.0})) ==
         Approx(1.0).margin(1e-15));
 }
+
+TEST_CASE("mutual_information_lower_bound: at most I(x;Y), equal to log2(e) times its scalar sum") {
+  std::mt19937_64 rng(21);
+  for (std::size_t n : {1u, 3u, 4u, 5u, 8u, 17u, 64u, 70u}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const auto r = random_distribution(n, rng, 0.4), q = random_distribution(n, rng, 0.2);
+      const std::vector<float> row(r.begin(), r.end());
+      double reference = 0.0;
+      for (std::size_t i = 0; i < n; ++i)
+        if (row[i] > 0.0f && q[i] > 0.0) reference += static_cast<double>(row[i]) - q[i];
+      reference *= 1.4426950408889634;
+      const double bound = infolerp::mutual_information_lower_bound(row, q);
+      CHECK(bound == Approx(reference).margin(1e-15));
+      CHECK(bound <= infolerp::element_mutual_information(row, q) + 1e-12);
+    }
+  }
+}

@@ -52,10 +52,11 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
-// Preconditions: r from grow_regions(s, g, ...). Complexity per neighbouring pair: O(|A| + |B|)
-// plus O(band · log band); divergences only for the boundary and band triangles, each
-// JS(class, seed) once per set when clusters × classes <= 2^20 (else once per pair), once per
-// representative when the state has representative().
+// Preconditions: r from grow_regions(s, g, ...), g symmetric (a dual graph is). Complexity per
+// neighbouring pair: O(min(|A|, |B|)) to find the boundary, O(band · log band) for the band and
+// the path, and O(|A| + |B|) only when a new path is tried (the split). Divergences only for
+// the boundary and band triangles, each JS(class, seed) once per set when clusters × classes
+// <= 2^20 (else once per pair), once per representative when the state has representative().
 // Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
 // 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
 // per-pair buffers are reused from pair to pair.
@@ -93,8 +94,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   std::uint32_t moved = 0;
   std::vector<std::uint32_t> region(n, invalid_id), stack, members;
   // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
-  std::vector<std::uint64_t> boundary, edges, path;
-  std::vector<std::uint32_t> frontier, ends, endpoints, band, verts, adj_offsets, adj, from;
+  std::vector<std::uint64_t> boundary, edges, path, end_keys;
+  std::vector<std::uint32_t> frontier, far_side, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
   std::vector<std::pair<std::uint32_t, int>> degree;  // (vertex, degree) sorted
   std::vector<std::uint8_t> in_band(n, 0);           // all 0 between pairs
   std::vector<glm::dvec3> pos;
@@ -118,22 +119,33 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     // clang before 16 rejects for structured bindings.
     const std::uint32_t ca = pair.first, cb = pair.second;
     ++pair_index;
-    members.clear();
-    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
-               std::back_inserter(members));
-    // 1. Boundary edges and the triangles on them.
+    // 1. Boundary edges (the mesh edges of A's graph slots into B) and the triangles on them,
+    // found from the smaller cluster's side: the graph is symmetric, and a slot has a shared
+    // edge exactly when its reverse slot has one.
+    const bool from_a = members_of[ca].size() <= members_of[cb].size();
+    const std::uint32_t near = from_a ? ca : cb, far = from_a ? cb : ca;
     boundary.clear();
     frontier.clear();
-    for (std::uint32_t i : members) {
-      const std::uint32_t other = label[i] == ca ? cb : ca;
+    far_side.clear();
+    for (std::uint32_t i : members_of[near]) {
       bool on = false;
-      for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot)
-        if (label[g.neighbours[slot]] == other && slot_edge[slot] != no_edge) {
-          if (label[i] == ca) boundary.push_back(slot_edge[slot]);
-          on = true;
+      for (std::uint32_t slot = g.offsets[i]; slot < g.offsets[i + 1]; ++slot) {
+        const std::uint32_t j = g.neighbours[slot];
+        if (label[j] != far || slot_edge[slot] == no_edge) continue;
+        on = true;
+        far_side.push_back(j);
+        if (from_a) {
+          boundary.push_back(slot_edge[slot]);
+        } else {  // A's slot back to i, with A's edge key (a triangle may share 3 vertices with i)
+          for (std::uint32_t back = g.offsets[j]; back < g.offsets[j + 1]; ++back)
+            if (g.neighbours[back] == i) boundary.push_back(slot_edge[back]);
         }
+      }
       if (on) frontier.push_back(i);
     }
+    std::sort(far_side.begin(), far_side.end());
+    far_side.erase(std::unique(far_side.begin(), far_side.end()), far_side.end());
+    frontier.insert(frontier.end(), far_side.begin(), far_side.end());
     std::sort(boundary.begin(), boundary.end());
     boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
     degree.clear();
@@ -207,27 +219,32 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     if (edges.size() == boundary.size()) continue;  // nothing to choose from
 
     // 3. A* between the end vertices over the band edges.
-    verts.clear();
-    for (auto e : edges) {
-      verts.push_back(static_cast<std::uint32_t>(e >> 32));
-      verts.push_back(static_cast<std::uint32_t>(e & 0xffffffffu));
+    // Local vertex ids, ascending with the mesh ids: the edge ends (vertex in the high half,
+    // end slot 2e or 2e + 1 in the low half) sorted and numbered in one pass.
+    end_keys.clear();
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      end_keys.push_back((edges[e] & ~std::uint64_t{0xffffffffu}) | (2 * e));
+      end_keys.push_back((edges[e] << 32) | (2 * e + 1));
     }
-    std::sort(verts.begin(), verts.end());
-    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    std::sort(end_keys.begin(), end_keys.end());
+    verts.clear();
+    end_vertex.resize(end_keys.size());
+    for (std::uint64_t key : end_keys) {
+      const auto v = static_cast<std::uint32_t>(key >> 32);
+      if (verts.empty() || verts.back() != v) verts.push_back(v);
+      end_vertex[key & 0xffffffffu] = static_cast<std::uint32_t>(verts.size() - 1);
+    }
     auto vid = [&](std::uint32_t v) {
       return static_cast<std::uint32_t>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
     };
     // Adjacency (CSR, each vertex's neighbours in `edges` order).
     adj_offsets.assign(verts.size() + 1, 0);
     adj.resize(2 * edges.size());
-    for (auto e : edges) {
-      ++adj_offsets[vid(static_cast<std::uint32_t>(e >> 32)) + 1];
-      ++adj_offsets[vid(static_cast<std::uint32_t>(e & 0xffffffffu)) + 1];
-    }
+    for (std::uint32_t v : end_vertex) ++adj_offsets[v + 1];
     for (std::size_t i = 0; i < verts.size(); ++i) adj_offsets[i + 1] += adj_offsets[i];
     from.assign(adj_offsets.begin(), adj_offsets.end() - 1);  // fill cursors, reused below
-    for (auto e : edges) {
-      const std::uint32_t a = vid(static_cast<std::uint32_t>(e >> 32)), b = vid(static_cast<std::uint32_t>(e & 0xffffffffu));
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      const std::uint32_t a = end_vertex[2 * e], b = end_vertex[2 * e + 1];
       adj[from[a]++] = b;
       adj[from[b]++] = a;
     }
@@ -272,6 +289,9 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     };
 
     // 4. Split A ∪ B along the path.
+    members.clear();
+    std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
+               std::back_inserter(members));
     std::uint32_t regions = 0;
     for (std::uint32_t i : members) {
       if (region[i] != invalid_id) continue;

@@ -40,8 +40,9 @@ namespace infolerp {
 // Optional, used when present:
 //   divergences(a, first, out) -> out[i] = divergence(a, first + i), a batch that may share work
 //   all_alike() -> bool: every row is identical (the clustering then skips all work)
-//   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th (false
-//       may mean either); growth then needs the exact JS only where two seeds claim an element
+//   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th − 2⁻²²
+//       (false may mean either; the margin keeps the float JS columns of region growing on the
+//       same side of th); growth then needs the exact JS only where two seeds claim an element
 //   mutual_information_lower_bound(c) -> double: <= mutual_information(c) up to 1e-9; the first
 //       seed then evaluates MI only for classes whose bound can reach the smallest MI
 //   representative(c) -> class r <= c whose divergences to every class are bit-identical to

@@ -14,8 +14,10 @@
 //                the bound is within 1e-9 of the MI of the class of smallest bound.
 //                Lazy: a seed's JS is evaluated (in parallel) only for the classes still
 //                candidates, and during growth only where its frontier arrives, once per
-//                (seed, class); with the state's surely_within, growth evaluates it exactly
-//                only where two seeds claim an element in the same ring. With the state's
+//                (seed, class); with the state's surely_within, a candidate the bound puts
+//                within Th of the new seed is dropped without its JS (it could not be a seed
+//                any more), and growth evaluates JS exactly only where two seeds claim an
+//                element in the same ring. With the state's
 //                representative(), an entry whose representative is evaluated in the same
 //                batch is copied from it (bit-identical). Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
@@ -89,7 +91,8 @@ struct region_growing_result {
 namespace detail {
 
 // JS column entries that are not a value (JS is never negative): not evaluated (yet), and
-// "JS <= Th − 1e-9 by the state's surely_within, value not evaluated".
+// "JS <= Th − 2⁻²² by the state's surely_within, value not evaluated" (so the float of the
+// value would also be < Th: a bounded entry decides as the exact one would).
 inline constexpr float js_unknown = -1.0f;
 inline constexpr float js_bounded = -3.0f;
 // Transient marks inside one js_entries call (and growth's batch): to evaluate, to copy.
@@ -180,7 +183,8 @@ inline void component_clusters(const element_graph& g, region_growing_result& r)
 // every class that was still a candidate (JS > Th to seeds 0..k-1) when seed k was chosen; the
 // other entries are js_unknown. Lazy: a class with JS <= Th to some seed can never become a
 // seed, and its summed JS no longer matters, so it is not evaluated against later seeds (the
-// seeds are the same as with full columns).
+// seeds are the same as with full columns). With the state's surely_within, entries the bound
+// decides (JS <= Th) are js_bounded and need no divergence: those classes are dropped anyway.
 // Preconditions: 0 < threshold < 1, class_count() >= 1.
 // Complexity: U MI evaluations + one divergence per (seed, class still a candidate), at most
 // U per seed. Allocation U floats per seed.
@@ -219,7 +223,7 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
     seeds.push_back(next);
     columns.emplace_back(u, detail::js_unknown);
     auto& col = columns.back();
-    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec);
+    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec, threshold);
     std::uint32_t best = invalid_id;
     std::size_t kept = 0;
     for (std::uint32_t c : candidates) {

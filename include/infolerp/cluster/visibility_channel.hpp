@@ -136,8 +136,10 @@ class visibility_state {
   //   JS_π(P,Q) <= h(π)·Σ_{p>q}(p − q) + h(1 − π)·Σ_{q>p}(q − p) <= h_max·Σ|p − q|,
   // h(x) = −x·log₂x <= h_max = 1/(e·ln 2) ≈ 0.53074 (the per-bin term f(p,q) is convex and
   // 1-homogeneous, so for p >= q f(p,q) <= f(q,q) + f(p − q, 0) = (p − q)·h(π), and
-  // symmetrically). The bound must be 1e-9 below the threshold (the kernel is accurate to
-  // ~1e-15), so a true answer always agrees with divergence(); false means "not decided".
+  // symmetrically). The bound must be 2⁻²² below the threshold: more than the kernel's error
+  // (~1e-15) and than the rounding of a JS value to a float column entry (region_growing.hpp),
+  // so a true answer always agrees with divergence() and with that entry; false means "not
+  // decided".
   // Σ|p − q| is summed in float (8 lanes, twice the SSE width of doubles) and inflated by
   // (N + 16)·2⁻²², more than its rounding (at most (N/8 + 4) float ulps, relative).
   // O(N), no allocation.
@@ -152,7 +154,7 @@ class visibility_state {
     for (; v < n_; ++v) l1[0] += std::abs(ra[v] - rb[v]);
     const double sum = static_cast<double>(((l1[0] + l1[1]) + (l1[2] + l1[3])) + ((l1[4] + l1[5]) + (l1[6] + l1[7])));
     constexpr double h_max = 0.53074;  // > 1/(e·ln 2) = 0.5307378...
-    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 1e-9;
+    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 0x1p-22;
   }
   // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
@@ -162,24 +164,12 @@ class visibility_state {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
     return element_mutual_information(row(t), output_);
   }
-  // A lower bound of mutual_information(t) without logarithms: each bin the kernel sums
-  // (p > 0, q > 0) has p·ln(p/q) >= p − q, so I(t;V) >= log₂e·Σ(p − q) over those bins
-  // (the kernel's rounding, ~1e-15, is far inside the seed search's 1e-9 margin). +inf when
+  // A lower bound of mutual_information(t) without logarithms (info/entropy.hpp), +inf when
   // unseen. Most rows of a mesh are far from p(V), so the seed search evaluates few MIs.
   // O(N), no allocation.
   double mutual_information_lower_bound(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
-    const float* r = rows_.data() + std::size_t{t} * n_;
-    double sum[4] = {};  // 4 independent sums
-    std::size_t v = 0;
-    auto term = [&](std::size_t i) {
-      const double p = r[i], q = output_[i];
-      return p > 0.0 && q > 0.0 ? p - q : 0.0;
-    };
-    for (; v + 4 <= n_; v += 4)
-      for (std::size_t lane = 0; lane < 4; ++lane) sum[lane] += term(v + lane);
-    for (; v < n_; ++v) sum[0] += term(v);
-    return std::numbers::log2e * ((sum[0] + sum[1]) + (sum[2] + sum[3]));
+    return infolerp::mutual_information_lower_bound(row(t), std::span<const double>(output_));
   }
 
  private:
@@ -266,10 +256,10 @@ struct prepared_visibility_channel {
     for (double w : weight) active += w > 0.0 ? 1 : 0;
     visibility_state s;
     s.n_ = n;
-    s.rows_.assign(m * n, 0.0f);
     s.p_.assign(m, 0.0);
     s.output_.assign(n, 0.0);
     if (active == 0) {  // nothing of the set is seen from anywhere: one class, all alike
+      s.rows_.assign(m * n, 0.0f);
       s.all_alike_ = true;
       s.rep_.assign(m, 0);
       return s;
@@ -281,6 +271,8 @@ struct prepared_visibility_channel {
     for (std::uint32_t c = 0; c <= samples; ++c)
       for (std::size_t v = 0; v < n; ++v) ptv_of[c * n + v] = weight[v] > 0.0 ? ratio[c] / weight[v] : 0.0;
     std::vector<double> ptv(n);
+    std::vector<float> row(n);
+    s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
     for (std::size_t i = 0; i < m; ++i) {
       const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
       double pt = 0.0;
@@ -289,8 +281,8 @@ struct prepared_visibility_channel {
         pt += pv * ptv[v];
       }
       s.p_[i] = pt;
-      if (pt > 0.0)
-        for (std::size_t v = 0; v < n; ++v) s.rows_[i * n + v] = static_cast<float>(pv * ptv[v] / pt);
+      for (std::size_t v = 0; v < n; ++v) row[v] = pt > 0.0 ? static_cast<float>(pv * ptv[v] / pt) : 0.0f;
+      s.rows_.insert(s.rows_.end(), row.begin(), row.end());
     }
     if (denoise && threshold > 0.0) denoise_rows(triangles, s);
     s.find_representatives();
@@ -320,10 +312,14 @@ struct prepared_visibility_channel {
       const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
       return it != sorted.end() && it->first == t ? it->second : invalid_id;
     };
-    std::vector<float> out(m * n, 0.0f);  // unseen rows stay 0
+    std::vector<float> out, row(n);
+    out.reserve(m * n);  // appended row by row: no M×N zero fill first
     std::vector<double> acc(n);
     for (std::uint32_t i = 0; i < m; ++i) {
-      if (s.unseen(i)) continue;
+      if (s.unseen(i)) {  // stays 0
+        out.insert(out.end(), n, 0.0f);
+        continue;
+      }
       std::fill(acc.begin(), acc.end(), 0.0);
       std::size_t count = 0;
       auto add = [&](std::size_t j) {
@@ -336,7 +332,14 @@ struct prepared_visibility_channel {
         const std::uint32_t j = local_of(neighbours[k]);
         if (j != invalid_id && !s.unseen(j) && s.within(i, j, threshold)) add(j);
       }
-      for (std::size_t v = 0; v < n; ++v) out[i * n + v] = static_cast<float>(acc[v] / static_cast<double>(count));
+      // acc / count; by a power of two as a product by its inverse (the same bits, no division).
+      const auto c = static_cast<double>(count);
+      if ((count & (count - 1)) == 0) {
+        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(acc[v] * (1.0 / c));
+      } else {
+        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(acc[v] / c);
+      }
+      out.insert(out.end(), row.begin(), row.end());
     }
     s.rows_ = std::move(out);
   }

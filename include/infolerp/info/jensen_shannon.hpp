@@ -230,6 +230,42 @@ double kl_kernel(const T* p, const double* q, std::size_t n) noexcept {
 #endif
   return kl_kernel_on<js_vd, js_vu>(p, q, n);
 }
+
+// log₂e·Σ_i (p_i − q_i) over the bins with p_i > 0 and q_i > 0: a lower bound of kl_kernel
+// without logarithms (p·ln(p/q) >= p − q), summed like kl_kernel_on.
+template <class D, class U, class T>
+INFOLERP_JS_INLINE double kl_lower_bound_on(const T* p, const double* q, std::size_t n) noexcept {
+  constexpr std::size_t lanes = sizeof(D) / sizeof(double), accumulators = 4 / lanes;
+  D acc[accumulators] = {};
+  D a, b;
+  for (std::size_t i = 0, v = 0; i < n; i += lanes, ++v) {  // tail zero-padded: p = 0 adds 0
+    js_load<false>(a, p + i, n - i, 1.0, 1.0);
+    js_load<false>(b, q + i, n - i, 1.0, 1.0);
+#if INFOLERP_JS_VECTOR
+    const U keep = INFOLERP_BIT_CAST(U, (a > 0.0) & (b > 0.0));
+#else
+    const U keep = std::uint64_t{0} - static_cast<std::uint64_t>(a > 0.0 && b > 0.0);
+#endif
+    acc[v % accumulators] += INFOLERP_BIT_CAST(D, INFOLERP_BIT_CAST(U, a - b) & keep);
+  }
+  double lane[4];
+  static_assert(sizeof acc == sizeof lane);
+  std::memcpy(lane, acc, sizeof lane);
+  return log2_e * ((lane[0] + lane[1]) + (lane[2] + lane[3]));
+}
+#ifdef INFOLERP_JS_AVX2
+template <class T>
+__attribute__((target("avx2"))) double kl_lower_bound_avx2(const T* p, const double* q, std::size_t n) noexcept {
+  return kl_lower_bound_on<js_v4d, js_v4u>(p, q, n);
+}
+#endif
+template <class T>
+double kl_lower_bound(const T* p, const double* q, std::size_t n) noexcept {
+#ifdef INFOLERP_JS_AVX2
+  if (js_cpu_has_avx2()) return kl_lower_bound_avx2(p, q, n);
+#endif
+  return kl_lower_bound_on<js_vd, js_vu>(p, q, n);
+}
 #if INFOLERP_JS_VECTOR
 #pragma GCC diagnostic pop
 #endif
