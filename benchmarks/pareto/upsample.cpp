@@ -699,6 +699,12 @@ int pareto_upsample(int argc, char** argv) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", scene.error().message().c_str());
     return 1;
   }
+  // lowres_bilinear's grids are sized to the ibuffer rows' evaluated fractions.
+  const auto listed = [&](const char* m) { return ("," + only + ",").find("," + std::string(m) + ",") != std::string::npos; };
+  if (!only.empty() && listed("lowres_bilinear") && !listed("ibuffer")) {
+    std::fprintf(stderr, "infolerp_pareto upsample: --only lowres_bilinear needs ibuffer too (its grids match the ibuffer rows' cost)\n");
+    return 2;
+  }
   const sup::shader_options shading{.ao_rays = static_cast<unsigned>(ao), .soft_shadow_rays = static_cast<unsigned>(soft)};
   std::printf("demo scene %dx%d, AO %d rays, soft shadow %d rays, threads %d\n", width, height, ao, soft,
               threads > 0 ? threads : omp_get_max_threads());

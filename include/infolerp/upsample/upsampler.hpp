@@ -42,7 +42,12 @@
 //     with a higher PSNR and 9%, 14%, 15%, 19% less CPU time (518 ids 2 and 3 passes, 159 ids 4
 //     and 5 passes). Before the per-row counters stopped sharing cache lines and the records
 //     stopped being copied whole (run_rows, sample_source.hpp), joint-bilateral was 3-6% faster
-//     at 1/4, 1/8 and 1/16 on the idle machine (upsample_1025_jb_idle.csv).
+//     at 1/4, 1/8 and 1/16 on the idle machine. Six idle runs since (wall, 2 threads; the last
+//     in upsample_1025_jb_idle.csv): the I-Buffer point with the next higher PSNR took
+//     -7.7 / -4.0 / -9.4 / -1.5 / -2.0 / +4.0% of joint-bilateral's time at 1/2, -14 / -8.9 /
+//     -10.4 / -3.6 / -9.1 / +2.5% at 1/4, -12 to -19% at 1/8 and -11 to -22% at 1/16: at the
+//     two finer grids both spend the same AO and soft-shadow work (25% and 6.3% of the pixels),
+//     and the margin (the sun rays the probes skip) is about the run-to-run noise.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
 // BM_UpsampleInterpolatedPixel, load ~3) is 9–15 ns per interpolated pixel, 17 ns with probes,
 // 13 ns with refined probes (the probes included).
