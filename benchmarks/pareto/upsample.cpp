@@ -602,8 +602,12 @@ class harness {
     // Plot: PSNR (capped at 60 dB for the exact methods) against seconds, one series per method.
     const std::string base = csv_path.size() > 4 && csv_path.ends_with(".csv") ? csv_path.substr(0, csv_path.size() - 4) : csv_path;
     std::ofstream dat(base + ".dat");
-    const char* methods[] = {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast",
-                             "ibuffer",     "ibuffer_linear", "ibuffer_probe",   "ibuffer_occl"};
+    // One data block per method that has rows (gnuplot numbers the blocks, so an empty block
+    // for a method left out by --only would shift every later title onto the wrong points).
+    std::vector<const char*> methods;
+    for (const char* m : {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer",
+                          "ibuffer_linear", "ibuffer_probe", "ibuffer_occl"})
+      if (std::any_of(rows_.begin(), rows_.end(), [&](const auto& r) { return r.method == m; })) methods.push_back(m);
     for (const char* m : methods) {
       dat << "# " << m << "\n";
       for (const auto& r : rows_)
@@ -616,7 +620,7 @@ class harness {
        << "set title 'Demo scene " << w_ << "x" << h_ << ": PSNR against render time (exact methods drawn at 60 dB)'\n"
        << "set xlabel 'CPU seconds, all threads (log)'\nset ylabel 'PSNR dB vs full per-pixel evaluation'\nset logscale x\nset grid\n"
        << "set key bottom right\nplot ";
-    for (int i = 0; i < 9; ++i)
+    for (std::size_t i = 0; i < methods.size(); ++i)
       gp << (i ? ", " : "") << "'" << base << ".dat' index " << i << " using 1:2 with points pt " << (i + 4)
          << " title '" << methods[i] << "'";
     gp << "\n";
