@@ -217,19 +217,6 @@ INFOLERP_JS_INLINE double kl_kernel_on(const T* p, const double* q, std::size_t 
   const double sum = (lane[0] + lane[1]) + (lane[2] + lane[3]);
   return sum > 0.0 ? sum : 0.0;
 }
-#ifdef INFOLERP_JS_AVX2
-template <class T>
-__attribute__((target("avx2"))) double kl_kernel_avx2(const T* p, const double* q, std::size_t n) noexcept {
-  return kl_kernel_on<js_v4d, js_v4u>(p, q, n);
-}
-#endif
-template <class T>
-double kl_kernel(const T* p, const double* q, std::size_t n) noexcept {
-#ifdef INFOLERP_JS_AVX2
-  if (js_cpu_has_avx2()) return kl_kernel_avx2(p, q, n);
-#endif
-  return kl_kernel_on<js_vd, js_vu>(p, q, n);
-}
 
 // log₂e·Σ_i (p_i − q_i) over the bins with p_i > 0 and q_i > 0: a lower bound of kl_kernel
 // without logarithms (p·ln(p/q) >= p − q), summed like kl_kernel_on.
@@ -253,18 +240,41 @@ INFOLERP_JS_INLINE double kl_lower_bound_on(const T* p, const double* q, std::si
   std::memcpy(lane, acc, sizeof lane);
   return log2_e * ((lane[0] + lane[1]) + (lane[2] + lane[3]));
 }
+
+// Both sums over (p, q) run as K::run<D, U>: the AVX2 lanes where the CPU has them, else the
+// portable ones (bit-identical, the same summation order).
+struct kl_sum {
+  template <class D, class U, class T>
+  INFOLERP_JS_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
+    return kl_kernel_on<D, U>(p, q, n);
+  }
+};
+struct kl_bound {
+  template <class D, class U, class T>
+  INFOLERP_JS_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
+    return kl_lower_bound_on<D, U>(p, q, n);
+  }
+};
 #ifdef INFOLERP_JS_AVX2
-template <class T>
-__attribute__((target("avx2"))) double kl_lower_bound_avx2(const T* p, const double* q, std::size_t n) noexcept {
-  return kl_lower_bound_on<js_v4d, js_v4u>(p, q, n);
+template <class K, class T>
+__attribute__((target("avx2"))) double kl_dispatch_avx2(const T* p, const double* q, std::size_t n) noexcept {
+  return K::template run<js_v4d, js_v4u>(p, q, n);
 }
 #endif
+template <class K, class T>
+double kl_dispatch(const T* p, const double* q, std::size_t n) noexcept {
+#ifdef INFOLERP_JS_AVX2
+  if (js_cpu_has_avx2()) return kl_dispatch_avx2<K>(p, q, n);
+#endif
+  return K::template run<js_vd, js_vu>(p, q, n);
+}
+template <class T>
+double kl_kernel(const T* p, const double* q, std::size_t n) noexcept {
+  return kl_dispatch<kl_sum>(p, q, n);
+}
 template <class T>
 double kl_lower_bound(const T* p, const double* q, std::size_t n) noexcept {
-#ifdef INFOLERP_JS_AVX2
-  if (js_cpu_has_avx2()) return kl_lower_bound_avx2(p, q, n);
-#endif
-  return kl_lower_bound_on<js_vd, js_vu>(p, q, n);
+  return kl_dispatch<kl_bound>(p, q, n);
 }
 #if INFOLERP_JS_VECTOR
 #pragma GCC diagnostic pop
