@@ -442,6 +442,11 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   check_cell("parameter underflows", "compute_saliency", sal({.scales = {1e-160}}), {errc::bad_parameter, "saliency sigma"});
   check_cell("parameter underflows", "compute_saliency(approx)",
              sal({.scales = {1e-160}, .method = infolerp::saliency_method::approximate}), {errc::bad_parameter, "saliency sigma"});
+  // A σ near 5e153 passed the σ² check, but the exact kernel's squared ball radius 4σ²
+  // overflowed and the averages became NaN (fuzzer).
+  const double huge_scale = 5e153 / (0.003 * infolerp::mesh_bounds(m).diagonal());
+  check_cell("parameter overflows", "compute_saliency", sal({.scales = {2.0, huge_scale}}),
+             {errc::bad_parameter, "saliency sigma"});
   check_cell("threshold below 0", "compute_saliency(approx)",
              sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = 0.1}),
              {errc::bad_parameter, "approx_cells_per_sigma"});

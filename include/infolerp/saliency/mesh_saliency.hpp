@@ -742,8 +742,9 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales, a scale <= 0 or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ whose square is not a
-// normal double (scale × epsilon × diagonal below ~1e-154 or above ~1e154) (bad_parameter); a
+// scales, a scale <= 0 or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ
+// (scale × epsilon × diagonal) below ~1.5e-154 or above ~3.3e153, where σ² underflows or 16σ²
+// overflows (bad_parameter); a
 // mesh whose bounding box has zero diagonal (degenerate_triangle).
 // Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
 // unordered pairs within 2σ_max, each evaluated once); approximate: O(V·σs·k) with
@@ -786,10 +787,12 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   std::vector<double> sigma(mult.size());
   for (std::size_t u = 0; u < mult.size(); ++u) {
     sigma[u] = mult[u] * out.epsilon;
-    // The Gaussian divides by 2σ²: a σ² that underflows (or overflows) would turn the weights
-    // of coincident vertices into NaN (0 · Inf).
+    // The Gaussian divides by 2σ²: a σ² that underflows would turn the weights of coincident
+    // vertices into NaN (0 · Inf); the ball's squared radius 4σ² must not overflow either (at
+    // σ ~5e153 the exact kernel's cutoff became Inf and the averages NaN; fuzzer). 16σ² leaves
+    // a factor 4 of headroom.
     const double s2 = sigma[u] * sigma[u];
-    if (!(s2 >= std::numeric_limits<double>::min()) || !std::isfinite(s2))
+    if (!(s2 >= std::numeric_limits<double>::min()) || !std::isfinite(16.0 * s2))
       return make_error(errc::bad_parameter, no_element, "saliency sigma ", sigma[u],
                         " (scale x epsilon x bounding-box diagonal) is outside double precision");
   }
