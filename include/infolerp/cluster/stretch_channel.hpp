@@ -118,6 +118,9 @@ struct stretch_kernel {
   std::size_t column_count() const { return first.size() - 1; }
   double column_size(std::uint32_t c) const { return cnt_prefix[first[c + 1]] - cnt_prefix[first[c]]; }
   // Σ over the column's elements of 1 − |s_a − s| (never negative: every s is in [0, 1]).
+  // A one-class column (exact and per-cell rows, every column) takes the direct product: fewer
+  // loads on the row-building path, and the bits those modes always had; the prefix sums give
+  // the same value to rounding.
   double mass(std::uint32_t a, std::uint32_t c) const {
     const std::uint32_t lo = first[c], hi = first[c + 1];
     if (hi == lo + 1) return counts[lo] * std::max(0.0, 1.0 - std::abs(reps[a] - reps[lo]));
