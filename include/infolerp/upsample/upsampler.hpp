@@ -372,14 +372,14 @@ class upsampler {
       if ((j & 1u) == 0) {
         if ((i & 1u) == 0) {
           store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
-        } else if (detail::may_interpolate(src, r0[a], r0[a + 1])) {
+        } else if (detail::may_interpolate(src, r0[a], r0[a + 1]) && detail::sources_agree(src, r0[a], r0[a + 1])) {
           store(src, d, i, j, detail::source_interpolate(src, r0[a], r0[a + 1]), sample_kind::interpolated, out,
                 counts);
         } else {
           store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
         }
       } else if ((i & 1u) == 0) {
-        if (detail::may_interpolate(src, r0[a], r1[a])) {
+        if (detail::may_interpolate(src, r0[a], r1[a]) && detail::sources_agree(src, r0[a], r1[a])) {
           store(src, d, i, j, detail::source_interpolate(src, r0[a], r1[a]), sample_kind::interpolated, out, counts);
         } else {
           store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
@@ -390,7 +390,7 @@ class upsampler {
         const Sample& s01 = r1[a];
         const Sample& s11 = r1[a + 1];
         if (detail::may_interpolate(src, s00, s10) && detail::may_interpolate(src, s00, s01) &&
-            detail::may_interpolate(src, s00, s11)) {
+            detail::may_interpolate(src, s00, s11) && detail::sources_agree(src, s00, s10, s01, s11)) {
           store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out,
                 counts);
         } else {
@@ -406,7 +406,8 @@ class upsampler {
   // sources that agree with each other and bracket the new sample (both of an edge; all four
   // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
   // leaves out is taken from sources on both sides of it; only where that fails is the probe
-  // refined and tested again, now with compatible() and min_sources. Otherwise evaluated.
+  // refined and tested again, now with compatible() and min_sources. Otherwise, or when the
+  // chosen sources do not all agree() pairwise (a source's optional tolerance), evaluated.
   template <class S, class Pixel>
   void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
                  std::array<std::size_t, 3>& counts) {
@@ -438,7 +439,8 @@ class upsampler {
       } else {
         k = choose_sources(src, p, r0, r1, i, j, single, cross_check, false, probe_match);
       }
-      if (k.n == 0) {
+      if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
+                                 : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
         store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
       } else if (k.n == 4) {
         store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
