@@ -804,6 +804,7 @@ TEST_CASE("agree(): sources of one cluster that differ by more than the toleranc
     tolerant<refining<ao_ramp>> refine;
     refine.tolerance = tolerance;
     check_kinds(refine, tolerance, centres);
+    CHECK(refine.refinements.load() == 0u);  // sources that disagree evaluate; the probe is not refined first
   }
   // Below 1/32 the edges are evaluated too: only the first pass's samples are reused.
   tolerant<probing<ao_ramp>> strict;
