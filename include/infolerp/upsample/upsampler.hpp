@@ -57,18 +57,19 @@
 //     two finer grids both spend the same AO and soft-shadow work (25% and 6.3% of the pixels),
 //     and the margin (the sun rays the probes skip) is about the run-to-run noise.
 //   refined probes + agree() (AO and soft shadow within T, occlusion_within), against
-//     joint-bilateral in the same run, CPU time, three runs at load 1.9-3.2 (2 threads;
-//     wall times meaningless at that load): 1/2 grid (59.54 dB) beaten by 159 ids, min 2
-//     sources, T 0.04, 4 passes (59.57 dB, 8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%)
-//     with 27-29% less CPU; 1/4 (56.05 dB) by 159 ids, min 2, T 0.16, 4 passes (56.18 dB,
-//     3.5%) with 10.6-11.2% less; 1/8 and 1/16 in the same runs by the rows without agree()
-//     (159 ids, min 1, 4 passes: 10.0-13.4% less; 143 or 159 ids, 5 passes: 13.3-14.6%;
-//     benchmarks/results/upsample_1025_tolerance.csv is the first). Evaluations beyond the coarse grid sit near geometry,
-//     where occlusion and clusters change, and cost up to twice an average pixel's (--diagnose,
-//     plain I-Buffer, load ~1.6: 10.4 us per evaluation per thread at 3 passes, 14.3 at 4,
-//     against 7.3 for the average pixel, sky included), so a tolerance buys little at 1/4;
-//     weighting the differences by the shading's ambient and area-light factors (tried)
-//     gained ~0.45 dB at equal evaluations but lost it again in agree()'s cost.
+//     joint-bilateral in the same run, CPU time, five runs at load 1.5-3.2 (2 threads; wall
+//     times meaningless at that load; benchmarks/results/upsample_1025_tolerance.csv is the
+//     first): 1/2 grid (59.54 dB) beaten by 159 ids, min 2 sources, T 0.04, 4 passes (59.57 dB,
+//     8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%) with 27-29% less CPU; 1/4 (56.05 dB)
+//     by 159 ids, min 2, T 0.16, 4 passes (56.18 dB, 3.5%) with 10.6-11.5% less; 1/8 and
+//     1/16 by rows without agree() (159 ids, min 1, 4 passes: 7.6-13.4% less; 143 or 159 ids,
+//     5 passes: 9.1-16.2%, each below 10% in one run). Evaluations beyond the coarse grid sit
+//     near geometry, where occlusion and clusters change, and cost up to twice an average
+//     pixel's (--diagnose, plain I-Buffer, load ~1.6: 10.4 us per evaluation per thread at 3
+//     passes, 14.3 at 4, against 7.3 for the average pixel, sky included), so a tolerance buys
+//     little at 1/4 and nothing at 1/8 and 1/16; weighting the differences by the shading's
+//     ambient and area-light factors (tried) gained ~0.45 dB at equal evaluations but lost it
+//     again in agree()'s cost.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
 // BM_UpsampleInterpolatedPixel, load 1.1, median of 3) is 10.5–15.4 ns per interpolated pixel
 // (5 to 2 passes), 18.9 ns with probes, 14.5 ns with refined probes (the probes included) and
