@@ -2,7 +2,8 @@
 // shading into the frame buffer, with a cheap synthetic sample source so that evaluation costs
 // almost nothing. Goal: at most 20 ns per interpolated pixel on one core. The cheap_probe_source
 // rows add a probe per new sample (as cheap as the evaluation here); cheap_refining_source's
-// probes leave out the light bits and are refined where needed (refine_probe).
+// probes leave out the light bits and are refined where needed (refine_probe); cheap_tolerant_source
+// adds agree() (a tolerance on the sources' occlusion terms).
 //   ns_per_interpolated = frame time / interpolated samples (all passes; conservative: the frame
 //                         time also pays for the few evaluated and the re-used samples)
 //   ns_per_pixel        = frame time / output pixels
@@ -55,6 +56,12 @@ struct cheap_refining_source : cheap_source {
   sample refine_probe(const sample&, std::uint32_t x, std::uint32_t y) const { return evaluate(x, y); }
 };
 
+// The refining source with agree() (sample_source.hpp): every chosen pair's occlusion terms
+// tested against a tolerance (all agree here, so the frame is the refining source's).
+struct cheap_tolerant_source : cheap_refining_source {
+  bool agree(const sample& a, const sample& b) const { return infolerp::occlusion_within(a, b, 0.05f); }
+};
+
 template <class Source>
 void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
   const auto passes = static_cast<std::uint32_t>(state.range(0));
@@ -84,6 +91,7 @@ void BM_UpsampleInterpolatedPixel(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_source)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_probe_source)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_refining_source)->Arg(4)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_UpsampleInterpolatedPixel, cheap_tolerant_source)->Arg(4)->Unit(benchmark::kMillisecond);
 
 // Plain per-pixel evaluation of the same cheap source (passes = 1), for comparison.
 void BM_UpsamplePlainEvaluation(benchmark::State& state) {

@@ -19,7 +19,9 @@
 //   ibuffer_probe     the I-Buffer with probes: the primary hit (and the sun ray, "+sun") at every
 //                     pixel, AO and soft shadow interpolated from the sources matching the new
 //                     sample's own cluster id (min_sources 1 or 2); "sun where needed": probes of the
-//                     primary ray only, refined with the sun ray where two agreeing sources do not suffice
+//                     primary ray only, refined with the sun ray where two agreeing sources do not suffice;
+//                     "AO+soft within T": also evaluated unless the chosen sources' AO and soft-shadow
+//                     ratios differ pairwise by at most T (agree(), sample_source.hpp)
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
@@ -254,6 +256,26 @@ class harness {
                           c->count(), min_sources, passes);
             if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
           }
+      // The same, evaluating where the chosen sources' AO or soft-shadow ratios differ by more
+      // than a tolerance (agree(), sample_source.hpp): the demo clustering and one coarser (159 ids).
+      with.assign({&features});
+      if (coarser.size() > 1) with.push_back(&coarser[1]);
+      for (const sup::scene_clustering* c : with)
+        for (std::uint32_t min_sources = 1; min_sources <= 2; ++min_sources)
+          for (float tolerance : {0.02f, 0.04f, 0.08f, 0.16f})
+            for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+              sup::demo_tolerant_probe_source src;
+              static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+              src.primary = &primary;
+              src.probe_lights = false;
+              src.primary_sun = &primary_sun;
+              src.tolerance = tolerance;
+              double f = 0;
+              char setting[160];
+              std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min %u src, AO+soft within %.2f, %u passes",
+                            c->name.c_str(), c->count(), min_sources, static_cast<double>(tolerance), passes);
+              if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
+            }
     }
     // (6b) the I-Buffer with the occlusion terms also tested.
     for (float tolerance : {0.05f, 0.1f}) {

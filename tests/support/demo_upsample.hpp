@@ -173,6 +173,14 @@ struct demo_refining_probe_source : demo_probe_source {
   }
 };
 
+// The same, and a new sample is evaluated unless its chosen sources' AO and soft-shadow ratios
+// differ pairwise by at most `tolerance` (agree(), sample_source.hpp): adaptive refinement on
+// top of the cluster test, between two pass counts' evaluated fractions.
+struct demo_tolerant_probe_source : demo_refining_probe_source {
+  float tolerance = 0.05f;
+  bool agree(const demo_sample& a, const demo_sample& b) const { return occlusion_within(a, b, tolerance); }
+};
+
 // Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.
 inline float display_luma(glm::vec3 linear) {
   return (0.2126f * to_srgb8(linear.x) + 0.7152f * to_srgb8(linear.y) + 0.0722f * to_srgb8(linear.z)) / 255.0f;

@@ -692,3 +692,154 @@ TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in pe
   CHECK(e_perspective < 1e-4f);
   CHECK(e_linear > 1e-2f);
 }
+
+namespace {
+// Base with agree(): the chosen sources' occlusion terms within `tolerance` (occlusion_within).
+template <class Base>
+struct tolerant : Base {
+  float tolerance = std::numeric_limits<float>::infinity();
+  bool agree(const sample& a, const sample& b) const { return infolerp::occlusion_within(a, b, tolerance); }
+};
+
+// One cluster, lit; AO = 1/2 + (x − y)/64 (dyadic, exact): the last of two passes has sources
+// 2 px apart, so an edge's two sources differ by 1/32 in AO and a centre's four corners by
+// 1/16 between its diagonal neighbours 10 and 01, while corner 00 differs from each of the
+// other three by at most 1/32.
+struct ao_ramp {
+  using sample_type = sample;
+  sample evaluate(std::uint32_t xi, std::uint32_t yi) const {
+    sample s;
+    s.cluster = 0;
+    s.lights = 1;
+    s.texcoord = {static_cast<float>(xi), static_cast<float>(yi)};
+    s.occlusion = {0.5f + (static_cast<float>(xi) - static_cast<float>(yi)) / 64.0f, 0.25f};
+    return s;
+  }
+  glm::vec4 shade(const sample& s, std::uint32_t, std::uint32_t) const { return glm::vec4(s.occlusion[0]); }
+};
+
+// Renders src with the given passes and min_sources, keeping samples and kinds.
+template <class Src>
+infolerp::upsampler<sample> rendered(const Src& src, std::uint32_t w, std::uint32_t h, std::uint32_t passes,
+                                     std::vector<glm::vec4>& out, std::uint32_t min_sources = 2) {
+  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
+                                                      .min_sources = min_sources});
+  REQUIRE(u.ok());
+  out.assign(static_cast<std::size_t>(w) * h, glm::vec4(-3.0f));
+  REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+  return std::move(*u);
+}
+}  // namespace
+
+TEST_CASE("occlusion_within: every term within the tolerance, both ways", "[upsample]") {
+  sample a, b;
+  a.occlusion = {0.5f, 0.25f};
+  b.occlusion = {0.75f, 0.25f};
+  CHECK(infolerp::occlusion_within(a, b, 0.25f));
+  CHECK(infolerp::occlusion_within(b, a, 0.25f));
+  CHECK_FALSE(infolerp::occlusion_within(a, b, 0.125f));
+  CHECK_FALSE(infolerp::occlusion_within(b, a, 0.125f));
+  b.occlusion = {0.5f, 0.0f};
+  CHECK_FALSE(infolerp::occlusion_within(a, b, 0.125f));  // the second term
+  CHECK(infolerp::occlusion_within(a, b, std::numeric_limits<float>::infinity()));
+  b.occlusion[1] = std::numeric_limits<float>::quiet_NaN();  // unset terms never agree
+  CHECK_FALSE(infolerp::occlusion_within(a, b, std::numeric_limits<float>::infinity()));
+}
+
+TEST_CASE("agree() off (infinite tolerance) gives today's frames bit for bit, plain and with probes", "[upsample]") {
+  const std::uint32_t w = 257, h = 190;
+  auto same = [&](const auto& without, const auto& with, std::uint32_t passes, std::uint32_t min_sources) {
+    INFO("passes " << passes << " min_sources " << min_sources);
+    std::vector<glm::vec4> a, b;
+    const auto ua = rendered(without, w, h, passes, a, min_sources);
+    const auto ub = rendered(with, w, h, passes, b, min_sources);
+    CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec4)) == 0);
+    CHECK(std::equal(ua.kinds().begin(), ua.kinds().end(), ub.kinds().begin()));
+    CHECK(ua.stats().evaluated() == ub.stats().evaluated());
+    if (passes > 1) CHECK(ua.stats().evaluated() > ua.stats().pass[0].evaluated);  // boundaries were evaluated
+  };
+  for (std::uint32_t passes = 1; passes <= 5; ++passes) {
+    same(wavy{}, tolerant<wavy>{}, passes, 2);
+    for (std::uint32_t min_sources : {1u, 2u}) {
+      same(probing<wavy>{}, tolerant<probing<wavy>>{}, passes, min_sources);
+      same(refining<wavy>{}, tolerant<refining<wavy>>{}, passes, min_sources);
+    }
+  }
+}
+
+TEST_CASE("agree(): sources of one cluster that differ by more than the tolerance are evaluated", "[upsample]") {
+  const std::uint32_t w = 17, h = 9;
+  // 1/32 < 0.05 < 1/16: edges agree, centres do not (their corners 10 and 01 differ by 1/16,
+  // although 00 is within 1/32 of every other corner: the test must not stop at 00).
+  auto check_kinds = [&](const auto& src, float tolerance, bool centres_evaluated) {
+    INFO("tolerance " << tolerance);
+    std::vector<glm::vec4> out;
+    for (std::uint32_t min_sources : {1u, 2u}) {
+      const auto u = rendered(src, w, h, 2, out, min_sources);
+      std::size_t wrong = 0, wrong_value = 0;
+      for (std::uint32_t y = 0; y < h; ++y)
+        for (std::uint32_t x = 0; x < w; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * w + x;
+          const bool centre = (x & 1u) && (y & 1u), coarse = !(x & 1u) && !(y & 1u);
+          const sample_kind want = coarse ? sample_kind::reused
+                                   : centre && centres_evaluated ? sample_kind::evaluated
+                                                                 : sample_kind::interpolated;
+          wrong += u.kinds()[i] == want ? 0 : 1;
+          // AO is linear: interpolated or evaluated, every value is exact.
+          wrong_value += u.ibuffer()[i].occlusion[0] == ao_ramp{}.evaluate(x, y).occlusion[0] ? 0 : 1;
+        }
+      CHECK(wrong == 0);
+      CHECK(wrong_value == 0);
+      CHECK(u.stats().pass[1].evaluated == (centres_evaluated ? (w / 2) * (h / 2) : 0u));
+    }
+  };
+  for (float tolerance : {0.05f, 0.07f}) {
+    const bool centres = tolerance < 0.0625f;
+    tolerant<ao_ramp> plain;
+    plain.tolerance = tolerance;
+    check_kinds(plain, tolerance, centres);
+    tolerant<probing<ao_ramp>> probe;  // the probe's own occlusion is NaN: agree() never sees it
+    probe.tolerance = tolerance;
+    check_kinds(probe, tolerance, centres);
+    tolerant<refining<ao_ramp>> refine;
+    refine.tolerance = tolerance;
+    check_kinds(refine, tolerance, centres);
+    CHECK(refine.refinements.load() == 0u);  // sources that disagree evaluate; the probe is not refined first
+  }
+  // Below 1/32 the edges are evaluated too: only the first pass's samples are reused.
+  tolerant<probing<ao_ramp>> strict;
+  strict.tolerance = 0.01f;
+  std::vector<glm::vec4> out;
+  const auto u = rendered(strict, w, h, 2, out, 1);
+  CHECK(u.stats().pass[1].interpolated == 0u);
+  CHECK(u.stats().pass[1].reused == static_cast<std::size_t>((w + 1) / 2) * ((h + 1) / 2));
+}
+
+TEST_CASE("agree(): serial and parallel outputs are bit-identical", "[upsample]") {
+  std::vector<glm::vec4> out;
+  // Evaluations of the same source without agree(), for the serial frame's min_sources.
+  const auto untouched = [&](const auto& src, const auto& serial) {
+    return rendered(src, 257, 190, 4, out, serial.options().min_sources).stats().evaluated();
+  };
+  tolerant<probing<wavy>> probe;
+  probe.tolerance = 0.2f;
+  check_probe_frames_bit_identical(probe, [&](const auto& serial) {
+    CHECK(serial.stats().evaluated() > untouched(probing<wavy>{}, serial));  // the tolerance evaluated some samples
+    CHECK(serial.stats().interpolated() > serial.stats().evaluated());
+  });
+  tolerant<refining<wavy>> refine;
+  refine.tolerance = 0.2f;
+  check_probe_frames_bit_identical(refine, [&](const auto& serial) {
+    CHECK(serial.stats().evaluated() > untouched(refining<wavy>{}, serial));
+  });
+  // Plain path.
+  tolerant<wavy> plain;
+  plain.tolerance = 0.2f;
+  std::vector<glm::vec4> ref, par(static_cast<std::size_t>(257) * 190);
+  const auto serial = rendered(plain, 257, 190, 4, ref);
+  CHECK(serial.stats().evaluated() > rendered(wavy{}, 257, 190, 4, out).stats().evaluated());
+  auto up = make(257, 190, 4);
+  REQUIRE(up.render(plain, std::span<glm::vec4>(par), infolerp::support::thread_pool_executor{3}).ok());
+  CHECK(std::memcmp(par.data(), ref.data(), ref.size() * sizeof(glm::vec4)) == 0);
+  CHECK(std::equal(up.kinds().begin(), up.kinds().end(), serial.kinds().begin()));
+}

@@ -51,6 +51,16 @@
 // with each other and bracket the new sample do not suffice (upsampler.hpp). On the demo
 // scene (1025², 4 passes) 2.8% of the probes are refined with 518 ids, 2.0% with 159, so about
 // 97% of the probes trace no sun ray.
+//
+// Optionally, beyond the paper (adaptive refinement on top of the §4 test, any source):
+//   bool agree(const sample_type& a, const sample_type& b) const     may a and b be sources of
+//        one interpolation? e.g. their expensive terms differ by at most a tolerance
+//        (occlusion_within below for the default record)
+// (member only: a tolerance is the source's state). A new sample whose sources passed the §4
+// test is still evaluated unless every pair of its chosen sources agrees. agree() need not be
+// transitive: the upsampler tests all pairs (1 for an edge or a diagonal, 6 for four corners),
+// never only against a first source. It must be symmetric, thread-safe and deterministic like
+// compatible(); a source that always agrees gives exactly the frame of one without agree().
 #include <array>
 #include <concepts>
 #include <cstddef>
@@ -148,6 +158,16 @@ template <std::size_t K, bool L>
   return s;
 }
 
+// Whether every occlusion term (AO, soft-shadow ratios) of a and b differs by at most
+// `tolerance` (>= 0; +infinity: always). A source's agree() for the default record. O(K).
+template <std::size_t K, bool L>
+[[nodiscard]] constexpr bool occlusion_within(const surface_sample<K, L>& a, const surface_sample<K, L>& b,
+                                              float tolerance) noexcept {
+  for (std::size_t i = 0; i < K; ++i)
+    if (!(a.occlusion[i] - b.occlusion[i] <= tolerance && b.occlusion[i] - a.occlusion[i] <= tolerance)) return false;
+  return true;
+}
+
 namespace detail {
 // The primary-hit part of a probe (member by member, see above).
 template <std::size_t K, bool L>
@@ -225,6 +245,10 @@ template <class T>
 concept adl_probe_compatible = requires(const T& a) {
   { probe_compatible(a, a) } -> std::convertible_to<bool>;
 };
+template <class S>
+concept member_agree = requires(const S& s, const sample_of<S>& a) {
+  { s.agree(a, a) } -> std::convertible_to<bool>;
+};
 template <class T>
 concept adl_compatible = requires(const T& a) {
   { compatible(a, a) } -> std::convertible_to<bool>;
@@ -298,6 +322,21 @@ template <class S>
   } else {
     return compatible(a, b);
   }
+}
+// Whether the sources of one interpolation agree pairwise (true for a source without agree()).
+template <class S>
+[[nodiscard]] inline bool sources_agree(const S& s, const sample_of<S>& a, const sample_of<S>& b) {
+  if constexpr (member_agree<S>) {
+    return &a == &b || static_cast<bool>(s.agree(a, b));
+  } else {
+    return true;
+  }
+}
+template <class S>
+[[nodiscard]] inline bool sources_agree(const S& s, const sample_of<S>& a, const sample_of<S>& b, const sample_of<S>& c,
+                                        const sample_of<S>& d) {
+  return sources_agree(s, a, b) && sources_agree(s, a, c) && sources_agree(s, a, d) && sources_agree(s, b, c) &&
+         sources_agree(s, b, d) && sources_agree(s, c, d);
 }
 template <class S>
 [[nodiscard]] inline sample_of<S> source_interpolate(const S& s, const sample_of<S>& a, const sample_of<S>& b) {

@@ -27,6 +27,14 @@
 // hard-shadow rays where the sources that agree with each other and bracket the new sample do
 // not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
 //
+// Agreeing sources (optional, beyond the paper): a source with agree(a, b) has a new sample
+// evaluated, not interpolated, unless every pair of the sources chosen for it agrees (e.g. AO
+// and soft shadows within a tolerance, occlusion_within), in both the plain and the probe
+// path. This is adaptive refinement on top of the §4 test: a tolerance gives evaluated
+// fractions between those of two pass counts. It is not transitive, so all pairs are tested
+// (one for an edge or a diagonal, six for four corners). Cost: those agree() calls per new
+// sample plus the extra evaluations; sources without agree() compile it out.
+//
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
 // sun, 2 threads, process CPU time, least of 3 runs, one process, load average 3.3-3.6; full
 // per-pixel evaluation 3.33 s):
@@ -48,9 +56,24 @@
 //     -10.4 / -3.6 / -9.1 / +2.5% at 1/4, -12 to -19% at 1/8 and -11 to -22% at 1/16: at the
 //     two finer grids both spend the same AO and soft-shadow work (25% and 6.3% of the pixels),
 //     and the margin (the sun rays the probes skip) is about the run-to-run noise.
+//   refined probes + agree() (AO and soft shadow within T, occlusion_within), against
+//     joint-bilateral in the same run, CPU time, five runs at load 1.5-3.2 (2 threads; wall
+//     times meaningless at that load; benchmarks/results/upsample_1025_tolerance.csv is the
+//     first): 1/2 grid (59.54 dB) beaten by 159 ids, min 2 sources, T 0.04, 4 passes (59.57 dB,
+//     8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%) with 27-29% less CPU; 1/4 (56.05 dB)
+//     by 159 ids, min 2, T 0.16, 4 passes (56.18 dB, 3.5%) with 10.6-11.5% less; 1/8 and
+//     1/16 by rows without agree() (159 ids, min 1, 4 passes: 7.6-13.4% less; 143 or 159 ids,
+//     5 passes: 9.1-16.2%, each below 10% in one run). Evaluations beyond the coarse grid sit
+//     near geometry, where occlusion and clusters change, and cost up to twice an average
+//     pixel's (--diagnose, plain I-Buffer, load ~1.6: 10.4 us per evaluation per thread at 3
+//     passes, 14.3 at 4, against 7.3 for the average pixel, sky included), so a tolerance buys
+//     little at 1/4 and nothing at 1/8 and 1/16; weighting the differences by the shading's
+//     ambient and area-light factors (tried) gained ~0.45 dB at equal evaluations but lost it
+//     again in agree()'s cost.
 // (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
-// BM_UpsampleInterpolatedPixel, load ~3) is 9–15 ns per interpolated pixel, 17 ns with probes,
-// 13 ns with refined probes (the probes included).
+// BM_UpsampleInterpolatedPixel, load 1.1, median of 3) is 10.5–15.4 ns per interpolated pixel
+// (5 to 2 passes), 18.9 ns with probes, 14.5 ns with refined probes (the probes included) and
+// 15.7 ns with refined probes and agree() (occlusion_within).
 //
 // Determinism: each output row of a pass depends only on the previous pass, so rows run in
 // parallel through the user's executor and the output is identical for any executor and thread
@@ -372,14 +395,14 @@ class upsampler {
       if ((j & 1u) == 0) {
         if ((i & 1u) == 0) {
           store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
-        } else if (detail::may_interpolate(src, r0[a], r0[a + 1])) {
+        } else if (detail::may_interpolate(src, r0[a], r0[a + 1]) && detail::sources_agree(src, r0[a], r0[a + 1])) {
           store(src, d, i, j, detail::source_interpolate(src, r0[a], r0[a + 1]), sample_kind::interpolated, out,
                 counts);
         } else {
           store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
         }
       } else if ((i & 1u) == 0) {
-        if (detail::may_interpolate(src, r0[a], r1[a])) {
+        if (detail::may_interpolate(src, r0[a], r1[a]) && detail::sources_agree(src, r0[a], r1[a])) {
           store(src, d, i, j, detail::source_interpolate(src, r0[a], r1[a]), sample_kind::interpolated, out, counts);
         } else {
           store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
@@ -390,7 +413,7 @@ class upsampler {
         const Sample& s01 = r1[a];
         const Sample& s11 = r1[a + 1];
         if (detail::may_interpolate(src, s00, s10) && detail::may_interpolate(src, s00, s01) &&
-            detail::may_interpolate(src, s00, s11)) {
+            detail::may_interpolate(src, s00, s11) && detail::sources_agree(src, s00, s10, s01, s11)) {
           store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out,
                 counts);
         } else {
@@ -406,7 +429,8 @@ class upsampler {
   // sources that agree with each other and bracket the new sample (both of an edge; all four
   // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
   // leaves out is taken from sources on both sides of it; only where that fails is the probe
-  // refined and tested again, now with compatible() and min_sources. Otherwise evaluated.
+  // refined and tested again, now with compatible() and min_sources. Otherwise, or when the
+  // chosen sources do not all agree() pairwise (a source's optional tolerance), evaluated.
   template <class S, class Pixel>
   void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
                  std::array<std::size_t, 3>& counts) {
@@ -438,7 +462,8 @@ class upsampler {
       } else {
         k = choose_sources(src, p, r0, r1, i, j, single, cross_check, false, probe_match);
       }
-      if (k.n == 0) {
+      if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
+                                 : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
         store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
       } else if (k.n == 4) {
         store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
