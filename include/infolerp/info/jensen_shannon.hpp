@@ -168,13 +168,16 @@ INFOLERP_JS_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, do
     INFOLERP_JS_UNROLL
     for (std::size_t v = 0; v < block; ++v) js_finish(acc, v, stage[v]);
   }
-  for (std::size_t v = 0; i < n; i += lanes, ++v) {  // tail, zero-padded (zero bins add 0)
-    const std::size_t count = n - i;
-    js_stage<D> stage;
-    js_load<Scaled>(a, p + i, count, pre_p, inv_p);
-    js_load<Scaled>(b, q + i, count, pre_q, inv_q);
-    js_prepare<D, U>(stage, a, b, wp, wq);
-    js_finish(acc, v, stage);
+  if (i < n) {  // tail: one more stage, zero-padded (zero bins add exactly 0)
+    const std::size_t vectors = (n - i + lanes - 1) / lanes;
+    js_stage<D> stage[block];
+    for (std::size_t v = 0; v < vectors; ++v) {
+      const std::size_t at = i + v * lanes, count = std::min(lanes, n - at);
+      js_load<Scaled>(a, p + at, count, pre_p, inv_p);
+      js_load<Scaled>(b, q + at, count, pre_q, inv_q);
+      js_prepare<D, U>(stage[v], a, b, wp, wq);
+    }
+    for (std::size_t v = 0; v < vectors; ++v) js_finish(acc, v, stage[v]);
   }
   double lane[4];
   static_assert(sizeof acc == sizeof lane);
