@@ -198,9 +198,8 @@ class visibility_state {
     rep_.resize(m);
     std::size_t size = 1;
     while (size < 2 * m) size *= 2;
-    std::vector<std::uint32_t> table(size, invalid_id);
-    const std::size_t bytes = n_ * sizeof(float);
-    for (std::uint32_t t = 0; t < m; ++t) {
+    std::vector<std::uint32_t> table(size, invalid_id), home(m);
+    for (std::uint32_t t = 0; t < m; ++t) {  // first each row's home slot, then the probes
       const float* r = rows_.data() + std::size_t{t} * n_;
       constexpr std::uint64_t k = 0x9E3779B97F4A7C15ull;
       std::uint64_t h0 = std::bit_cast<std::uint64_t>(p_[t]), h1 = 1, h2 = 2, h3 = 3;  // independent chains
@@ -213,7 +212,15 @@ class visibility_state {
       }
       for (; v < n_; ++v) h0 = (h0 ^ std::bit_cast<std::uint32_t>(r[v])) * k;
       const std::uint64_t h = h0 ^ (h1 >> 13) ^ (h2 >> 26) ^ (h3 >> 39);
-      for (std::size_t slot = (h ^ (h >> 29)) & (size - 1);; slot = (slot + 1) & (size - 1)) {
+      home[t] = static_cast<std::uint32_t>((h ^ (h >> 29)) & (size - 1));
+    }
+    const std::size_t bytes = n_ * sizeof(float);
+    for (std::uint32_t t = 0; t < m; ++t) {
+#if defined(__GNUC__)
+      if (t + 8 < m) __builtin_prefetch(table.data() + home[t + 8]);  // random slots: ask ahead
+#endif
+      const float* r = rows_.data() + std::size_t{t} * n_;
+      for (std::size_t slot = home[t];; slot = (slot + 1) & (size - 1)) {
         const std::uint32_t o = table[slot];
         if (o == invalid_id) {
           table[slot] = rep_[t] = t;
