@@ -366,7 +366,11 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
     label[e] = k;
     queue.assign(1, e);
     const std::uint32_t sc = cls[e];
-    for (std::size_t q = 0; q < queue.size(); ++q)
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      if constexpr (detail::has_prefetch<S>)  // the rows tested next, a hint (far apart in memory)
+        if (q + 1 < queue.size())
+          for (std::uint32_t n : g.neighbours_of(queue[q + 1]))
+            if (label[n] == invalid_id) s.prefetch(cls[n]);
       for (std::uint32_t n : g.neighbours_of(queue[q])) {
         if (label[n] != invalid_id) continue;
         if (stamp[cls[n]] != k) {
@@ -377,6 +381,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
         label[n] = k;
         queue.push_back(n);
       }
+    }
   }
 
   // §3.2.4 merging, in passes.

@@ -9,18 +9,24 @@
 //
 // Speed: the two-way kernel is branch-free (info/log2.hpp) and, under GCC/Clang, written with
 // vector extensions: 2 doubles per SSE2 register, 4 per AVX register. On x86-64 a portable
-// build also carries an AVX2 copy of the kernel (target attribute, no FMA) chosen at run time
-// by __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one. Bins are
-// processed in blocks in two stages (ratios and divisions, then polynomials) so that
-// out-of-order cores overlap them. Measured (BM_JensenShannon*, benchmarks/bench_info.cpp, one
-// core of the shared 2-core dev VM, portable flags): SSE2 about 240 million bins/s, the
-// dispatched AVX2 kernel about 410 million (double and float rows alike; std::log2 per bin:
-// about 100 million); a 64-bin float row pair (the visibility channel) about 160 ns. Other
-// compilers get the same arithmetic one bin at a time. Four accumulators, combined as
-// (a0+a1)+(a2+a3), bin i going to a_(i mod 4): the result is bit-identical for every vector
-// width, so the dispatch never changes a result.
+// build also carries an AVX2 and an AVX-512F copy of the kernel (target attributes, no FMA:
+// contraction is switched off, see js_kernel_avx512) chosen at run time by
+// __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one,
+// INFOLERP_NO_AVX512 to stop at AVX2. Bins are processed in blocks in two stages (ratios and
+// divisions, then polynomials) so that out-of-order cores overlap them; a bin takes two
+// divisions (1/m, and one for both atanh arguments). Measured (BM_JensenShannon*,
+// benchmarks/bench_info.cpp, CPU time, one core of the shared 2-core dev VM at load 1.7,
+// portable flags, AVX-512 dispatched): about 420 million bins/s for double rows, 390 million
+// for float rows (the previous AVX2 kernel with three divisions per bin: 350 / 340 million in
+// the same runs; std::log2 per bin: about 88 million); a 64-bin float row pair (the
+// visibility channel) about 158 ns (was 189), a 257-bin double pair about 660 ns (was 748).
+// Other compilers get the same arithmetic one bin at a time. Four accumulators, combined as
+// (a0+a1)+(a2+a3), bin i going to a_(i mod 4) (8-lane vectors add their two halves in turn):
+// the result is bit-identical for every vector width, so the dispatch never changes a result
+// (tests/core/test_info.cpp compares the SSE2, AVX2 and AVX-512 kernels bit for bit).
 // Accuracy: within a few 1e-16 (absolute) of a long-double reference, including subnormal
-// entries, p ≈ q to the last bit and a million bins (tests/core/test_info.cpp).
+// entries, p ≈ q to the last bit and a million bins (tests/core/test_info.cpp); the shared
+// atanh division moved values by at most 2.2e-16 against the previous kernel.
 #include <algorithm>
 #include <bit>
 #include <cmath>
