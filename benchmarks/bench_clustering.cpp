@@ -11,22 +11,28 @@
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
 // Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
-//   BM_Clustering_RefinedElephant   251-266 ms CPU at load 1.8 (6 runs: 260 265 266 255 251 251),
-//     against 278-290 (281 281 290 279 278 282) for the previous version (027c16b, which
-//     measured ~251 ms on one idle core) in the same alternating runs, so ~227 ms idle
-//     expected (clang++ 14: 256 / 251 / 252 at load 1.7); at load 4.6 267-286 against
-//     294-315; ~1070 ms before the issue-3 speed work;
-//     clusters identical throughout (34 / 1960 / 4248, hash of cluster_of unchanged). Goal
-//     <= 150 ms NOT met. CPU per channel (load 4.75, so inflated): visibility ~180 (incl.
-//     validation and topology), orientation ~37-44, stretch ~41-43. Visibility JS evaluations
-//     (64 bins, ~160 ns each by BM_JensenShannon*; the kernel divides 3 times per bin): seed
-//     search 149k (+25k decided by surely_within, from 173k exact), growth 32k (+27k bounded,
-//     from 52k), smoothing 73k (63.5k distinct (class, cluster) pairs, so a memo across pairs
-//     would save little); bit-identical rows share their JS (69k groups for 89k rows); I(t;V)
-//     evaluated for ~1k rows (a vectorised log-free lower bound rules the rest out); denoising
-//     decides nearly all its tests by a bound. By profile (load ~4) the JS kernel on float
-//     rows is ~16% of the run, on the direct channels' double rows ~6%, smoothing's own work
-//     ~10%.
+//   BM_Clustering_RefinedElephant   280 / 282 / 287 ms CPU (median of 3 repetitions, 3 runs)
+//     against 306 / 306 / 304 for the previous version (ed66263, which measured 258-266 at
+//     load 0.4 earlier that day) in the same alternating runs at load 0.5-0.9: ~8% less;
+//     ~1070 ms before the issue-3 speed work. Clusters bit-identical (34 / 1960 / 4248, every
+//     cluster_of entry compared). Goal <= 150 ms NOT met. CPU per part (a harness mirroring
+//     cluster_mesh, median of 6, load 0.9, previous version in brackets): validation and
+//     topology 8.4 (9.0); visibility 181 (204): init 53 (57, of which ~13 are page faults of
+//     its two fresh M×N float buffers), seeds + growth 70 (81: seed search ~43, rings ~19,
+//     sequential pass 5.8 (8.5)), smoothing 55 (63: band flood 23 with 73k JS, split floods
+//     16.5, A* 6.7); orientation 44 (45: growth 17, smoothing 23); stretch 10 prepare + 48
+//     run (init 9, growth 23, smoothing 11). Visibility JS evaluations (64 bins, ~158 ns each
+//     in cache by BM_JensenShannon_Float, ~300 ns in smoothing's band flood, rows from memory): seed search
+//     149k (+25k decided by surely_within, from 173k exact), growth 32k (+27k bounded, from
+//     52k), sequential 18k, smoothing 73k (63.5k distinct (class, cluster) pairs); bit-identical
+//     rows share their JS (69k groups for 89k rows); I(t;V) evaluated for ~1k rows; denoising
+//     decides nearly all its tests by a bound. Tried and not kept (measured): per-row tables of
+//     log2 entries (one logarithm per bin: a 64-bin pair 189 -> 106 ns in cache, but the 35 MB
+//     table cost ~30 ms of init, mostly page faults, and the seed search gained ~5 ms as the
+//     rows then stream 3x the bytes; for the direct channels' rows it saved ~7 ms of growth and
+//     cost ~4.5 ms of stretch init); the log-free lower bound of I(x;Y) for the direct
+//     channels (no gain: stretch growth 22.6 -> 24.5 ms); the split of boundary smoothing by floods
+//     racing from the path (1.6x fewer triangles visited, 1.7x slower).
 //   Direct channels at K = 1024 (CPU, load 3.5; every figure in orientation_channel.hpp and
 //     stretch_channel.hpp): orientation on fandisk, exact rows ARI 0.997 at 52x less time than
 //     exact (29 ms against 1.52 s; per-cell rows 0.954); stretch on the UV sphere, exact rows

@@ -151,6 +151,47 @@ TEST_CASE("JS adversarial: subnormals, p == q up to the last bit, float32, a mil
   }
 }
 
+TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
+  // The portable kernel (SSE2 under GCC/Clang) against the AVX2 and AVX-512 copies the CPU
+  // has: lengths 1..300 (every tail), float and double rows, scaled and unscaled, random
+  // weights, zeros and equal bins.
+  using namespace infolerp::detail;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> w(0.0, 1.0);
+  std::size_t compared = 0;
+  auto check = [&](const auto& p, const auto& q, double wp) {
+    const auto* a = p.data();
+    const auto* b = q.data();
+    const std::size_t n = p.size();
+    const double portable = js_kernel_on<js_vd, js_vu, false>(a, b, n, wp, 1.0, 1.0, 1.0, 1.0);
+    const double scaled = js_kernel_on<js_vd, js_vu, true>(a, b, n, wp, 0x1p-3, 8.0, 2.0, 0.5);
+    (void)portable;
+    (void)scaled;
+#ifdef INFOLERP_JS_AVX2
+    if (js_cpu_has_avx2()) {
+      REQUIRE(js_kernel_avx2<false>(a, b, n, wp, 1.0, 1.0, 1.0, 1.0) == portable);
+      REQUIRE(js_kernel_avx2<true>(a, b, n, wp, 0x1p-3, 8.0, 2.0, 0.5) == scaled);
+      ++compared;
+    }
+#endif
+#ifdef INFOLERP_JS_AVX512
+    if (js_cpu_has_avx512()) {
+      REQUIRE(js_kernel_avx512<false>(a, b, n, wp, 1.0, 1.0, 1.0, 1.0) == portable);
+      REQUIRE(js_kernel_avx512<true>(a, b, n, wp, 0x1p-3, 8.0, 2.0, 0.5) == scaled);
+      ++compared;
+    }
+#endif
+  };
+  for (std::size_t n = 1; n <= 300; ++n) {
+    auto p = random_distribution(n, rng, 0.2), q = random_distribution(n, rng, 0.2);
+    for (std::size_t i = 0; i < n; i += 5) q[i] = p[i];  // equal bins contribute exactly 0
+    const double wp = w(rng);
+    check(p, q, wp);
+    check(std::vector<float>(p.begin(), p.end()), std::vector<float>(q.begin(), q.end()), wp);
+  }
+  if (compared == 0) WARN("no AVX2 or AVX-512 kernel on this build or CPU: only the portable one ran");
+}
+
 TEST_CASE("JS checked API: clear errors naming the bin") {
   const std::vector<double> good{0.25, 0.75}, three{0.2, 0.3, 0.5};
   CHECK(infolerp::jensen_shannon(good, three).error().code() == infolerp::errc::bad_distribution);

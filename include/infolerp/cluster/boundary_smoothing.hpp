@@ -189,17 +189,27 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
       return label[i] == cluster_a ? js_b < js_a : js_a < js_b;
     };
     band.clear();
-    for (std::uint32_t i : frontier)
-      if (prefers_other(i)) {
-        in_band[i] = 1;
-        band.push_back(i);
+    // With the state's prefetch(), the rows of the triangles tested next are asked for ahead
+    // (they are far apart in memory; a hint without effect on results).
+    auto prefetch = [&](std::uint32_t i) {
+      if constexpr (detail::has_prefetch<S>) s.prefetch(s.class_of(i));
+    };
+    for (std::size_t f = 0; f < frontier.size(); ++f) {
+      if (f + 4 < frontier.size()) prefetch(frontier[f + 4]);
+      if (prefers_other(frontier[f])) {
+        in_band[frontier[f]] = 1;
+        band.push_back(frontier[f]);
       }
-    for (std::size_t q = 0; q < band.size(); ++q)
+    }
+    for (std::size_t q = 0; q < band.size(); ++q) {
+      if (q + 1 < band.size())
+        for (std::uint32_t j : g.neighbours_of(band[q + 1])) prefetch(j);
       for (std::uint32_t j : g.neighbours_of(band[q]))
         if (!in_band[j] && label[j] == label[band[q]] && prefers_other(j)) {
           in_band[j] = 1;
           band.push_back(j);
         }
+    }
     for (std::uint32_t i : band) in_band[i] = 0;
     edges.assign(boundary.begin(), boundary.end());
     for (std::uint32_t i : band)
@@ -292,9 +302,18 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     members.clear();
     std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
                std::back_inserter(members));
+    // Flood fill of A ∪ B (members marked `unvisited`) without crossing the path, stopped as
+    // soon as the split cannot be kept: a first region holding both seeds, or a third region.
+    constexpr std::uint32_t unvisited = invalid_id - 1;
+    for (std::uint32_t i : members) region[i] = unvisited;
     std::uint32_t regions = 0;
+    bool two_parts = true;
     for (std::uint32_t i : members) {
-      if (region[i] != invalid_id) continue;
+      if (region[i] != unvisited) continue;
+      if (regions == 2) {
+        two_parts = false;
+        break;
+      }
       region[i] = regions;
       stack.push_back(i);
       while (!stack.empty()) {
@@ -302,16 +321,20 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         stack.pop_back();
         for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
           const std::uint32_t j = g.neighbours[slot];
-          if (region[j] != invalid_id || (label[j] != ca && label[j] != cb)) continue;
+          if (region[j] != unvisited) continue;
           if (slot_edge[slot] != no_edge && on_path(slot_edge[slot])) continue;
           region[j] = regions;
           stack.push_back(j);
         }
       }
+      if (region[r.seeds[ca]] == regions && region[r.seeds[cb]] == regions) {
+        two_parts = false;
+        break;
+      }
       ++regions;
     }
-    const std::uint32_t ra = region[r.seeds[ca]], rb = region[r.seeds[cb]];
-    if (regions == 2 && ra != rb) {
+    const std::uint32_t ra = region[r.seeds[ca]];
+    if (two_parts && regions == 2) {
       for (std::uint32_t i : members) {
         const std::uint32_t want = region[i] == ra ? ca : cb;
         if (label[i] != want) {

@@ -47,6 +47,8 @@ namespace infolerp {
 //       seed then evaluates MI only for classes whose bound can reach the smallest MI
 //   representative(c) -> class r <= c whose divergences to every class are bit-identical to
 //       c's (r == c when none); JS columns and smoothing memos are then shared within a group
+//   prefetch(c) -> void: a hint that class c's row is read soon (no effect on results); the
+//       seed search and boundary smoothing call it a few classes ahead
 // Thread-safety: const members are called concurrently from the executor's threads.
 template <class S>
 concept channel_state = requires(const S& s, std::uint32_t a, std::uint32_t b) {

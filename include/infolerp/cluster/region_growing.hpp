@@ -110,6 +110,9 @@ concept has_representative = requires(const S& s, std::uint32_t a) {
 };
 
 template <class S>
+concept has_prefetch = requires(const S& s, std::uint32_t a) { s.prefetch(a); };
+
+template <class S>
 concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
   { s.surely_within(a, a, th) } -> std::convertible_to<bool>;
 };
@@ -134,6 +137,10 @@ void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> whic
   for_each_chunk(exec, which.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e;) {
       const std::uint32_t c = which[i];
+      if constexpr (has_prefetch<S>) {
+        constexpr std::size_t ahead = 4;  // about one memory latency of divergences
+        if (i + ahead < e) s.prefetch(which[i + ahead]);
+      }
       if (col[c] == js_copy) {
         ++i;
         continue;
@@ -359,7 +366,11 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
     label[e] = k;
     queue.assign(1, e);
     const std::uint32_t sc = cls[e];
-    for (std::size_t q = 0; q < queue.size(); ++q)
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      if constexpr (detail::has_prefetch<S>)  // the rows tested next, a hint (far apart in memory)
+        if (q + 1 < queue.size())
+          for (std::uint32_t n : g.neighbours_of(queue[q + 1]))
+            if (label[n] == invalid_id) s.prefetch(cls[n]);
       for (std::uint32_t n : g.neighbours_of(queue[q])) {
         if (label[n] != invalid_id) continue;
         if (stamp[cls[n]] != k) {
@@ -370,6 +381,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
         label[n] = k;
         queue.push_back(n);
       }
+    }
   }
 
   // §3.2.4 merging, in passes.

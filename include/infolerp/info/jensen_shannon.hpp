@@ -9,18 +9,24 @@
 //
 // Speed: the two-way kernel is branch-free (info/log2.hpp) and, under GCC/Clang, written with
 // vector extensions: 2 doubles per SSE2 register, 4 per AVX register. On x86-64 a portable
-// build also carries an AVX2 copy of the kernel (target attribute, no FMA) chosen at run time
-// by __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one. Bins are
-// processed in blocks in two stages (ratios and divisions, then polynomials) so that
-// out-of-order cores overlap them. Measured (BM_JensenShannon*, benchmarks/bench_info.cpp, one
-// core of the shared 2-core dev VM, portable flags): SSE2 about 240 million bins/s, the
-// dispatched AVX2 kernel about 410 million (double and float rows alike; std::log2 per bin:
-// about 100 million); a 64-bin float row pair (the visibility channel) about 160 ns. Other
-// compilers get the same arithmetic one bin at a time. Four accumulators, combined as
-// (a0+a1)+(a2+a3), bin i going to a_(i mod 4): the result is bit-identical for every vector
-// width, so the dispatch never changes a result.
+// build also carries an AVX2 and an AVX-512F copy of the kernel (target attributes, no FMA:
+// contraction is switched off, see js_kernel_avx512) chosen at run time by
+// __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one,
+// INFOLERP_NO_AVX512 to stop at AVX2. Bins are processed in blocks in two stages (ratios and
+// divisions, then polynomials) so that out-of-order cores overlap them; a bin takes two
+// divisions (1/m, and one for both atanh arguments). Measured (BM_JensenShannon*,
+// benchmarks/bench_info.cpp, CPU time, one core of the shared 2-core dev VM at load 1.7,
+// portable flags, AVX-512 dispatched): about 420 million bins/s for double rows, 390 million
+// for float rows (the previous AVX2 kernel with three divisions per bin: 350 / 340 million in
+// the same runs; std::log2 per bin: about 88 million); a 64-bin float row pair (the
+// visibility channel) about 158 ns (was 189), a 257-bin double pair about 660 ns (was 748).
+// Other compilers get the same arithmetic one bin at a time. Four accumulators, combined as
+// (a0+a1)+(a2+a3), bin i going to a_(i mod 4) (8-lane vectors add their two halves in turn):
+// the result is bit-identical for every vector width, so the dispatch never changes a result
+// (tests/core/test_info.cpp compares the SSE2, AVX2 and AVX-512 kernels bit for bit).
 // Accuracy: within a few 1e-16 (absolute) of a long-double reference, including subnormal
-// entries, p ≈ q to the last bit and a million bins (tests/core/test_info.cpp).
+// entries, p ≈ q to the last bit and a million bins (tests/core/test_info.cpp); the shared
+// atanh division moved values by at most 2.2e-16 against the previous kernel.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -43,10 +49,15 @@ namespace detail {
 #define INFOLERP_JS_INLINE __attribute__((always_inline)) inline  // compiled into each ISA version
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // vectors only pass between inlined helpers
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF  // no a·b + c into FMA in the AVX-512 kernel (the same bits everywhere)
+#endif
 typedef double js_v2d __attribute__((vector_size(16)));
 typedef std::uint64_t js_v2u __attribute__((vector_size(16)));
 typedef double js_v4d __attribute__((vector_size(32)));
 typedef std::uint64_t js_v4u __attribute__((vector_size(32)));
+typedef double js_v8d __attribute__((vector_size(64)));
+typedef std::uint64_t js_v8u __attribute__((vector_size(64)));
 #if defined(__AVX__)
 using js_vd = js_v4d;
 using js_vu = js_v4u;
@@ -86,16 +97,28 @@ INFOLERP_JS_INLINE void js_prepare(js_stage<D>& s, const D& a, const D& b, doubl
   log2_reduce<D, U>(ra, a * inv_m);
   log2_reduce<D, U>(rb, b * inv_m);
   s.k = s.pa * ra.k + s.pb * rb.k;
-  s.sa = (ra.f - 1.0) / (ra.f + 1.0);
-  s.sb = (rb.f - 1.0) / (rb.f + 1.0);
+  // (f − 1)/(f + 1) for both with one division: d = 1/((f_a + 1)(f_b + 1)).
+  const D va = ra.f + 1.0, vb = rb.f + 1.0;
+  const D d = 1.0 / (va * vb);
+  s.sa = ((ra.f - 1.0) * vb) * d;
+  s.sb = ((rb.f - 1.0) * va) * d;
 }
-// Stage 2: acc += π₁p log₂(p/m) + π₂q log₂(q/m).
-template <class D>
-INFOLERP_JS_INLINE void js_finish(D& acc, const js_stage<D>& s) noexcept {
+// Stage 2: acc += π₁p log₂(p/m) + π₂q log₂(q/m). The partial sums are 4 lanes (bin i to
+// a_(i mod 4)): vectors of up to 4 lanes add into acc[v mod (4/lanes)], 8-lane vectors add
+// their low then their high half into one 4-lane acc (the same additions in the same order).
+template <class D, class A, std::size_t N>
+INFOLERP_JS_INLINE void js_finish(A (&acc)[N], std::size_t v, const js_stage<D>& s) noexcept {
   D la, lb;
   log_atanh_series(la, s.sa);
   log_atanh_series(lb, s.sb);
-  acc += s.k + (s.pa * la + s.pb * lb) * log2_e;
+  if constexpr (sizeof(D) == sizeof(A)) {
+    acc[v % N] += s.k + (s.pa * la + s.pb * lb) * log2_e;
+  } else {
+    const D t = s.k + (s.pa * la + s.pb * lb) * log2_e;
+    A half[sizeof(D) / sizeof(A)];
+    std::memcpy(half, &t, sizeof t);
+    for (const A& h : half) acc[0] += h;
+  }
 }
 
 // Loads `count` (< lanes allowed: zero-padded) entries as doubles, times scale (pre, then inv).
@@ -129,8 +152,14 @@ INFOLERP_JS_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, do
                                        double pre_q, double inv_q) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double);
   const double wq = 1.0 - wp;
-  constexpr std::size_t accumulators = 4 / lanes, block = 8;  // block: vectors per stage
-  D acc[accumulators] = {};
+  constexpr std::size_t block = lanes > 4 ? 4 : 8;  // vectors per stage
+#if INFOLERP_JS_VECTOR
+  using A = std::conditional_t<(lanes > 4), js_v4d, D>;  // partial sums: at most 4 lanes
+#else
+  using A = D;
+#endif
+  constexpr std::size_t accumulators = 4 / (sizeof(A) / sizeof(double));
+  A acc[accumulators] = {};
   D a, b;
   std::size_t i = 0;
   for (; i + block * lanes <= n; i += block * lanes) {
@@ -143,15 +172,18 @@ INFOLERP_JS_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, do
       js_prepare<D, U>(stage[v], a, b, wp, wq);
     }
     INFOLERP_JS_UNROLL
-    for (std::size_t v = 0; v < block; ++v) js_finish(acc[v % accumulators], stage[v]);
+    for (std::size_t v = 0; v < block; ++v) js_finish(acc, v, stage[v]);
   }
-  for (std::size_t v = 0; i < n; i += lanes, ++v) {  // tail, zero-padded (zero bins add 0)
-    const std::size_t count = n - i;
-    js_stage<D> stage;
-    js_load<Scaled>(a, p + i, count, pre_p, inv_p);
-    js_load<Scaled>(b, q + i, count, pre_q, inv_q);
-    js_prepare<D, U>(stage, a, b, wp, wq);
-    js_finish(acc[v % accumulators], stage);
+  if (i < n) {  // tail: one more stage, zero-padded (zero bins add exactly 0)
+    const std::size_t vectors = (n - i + lanes - 1) / lanes;
+    js_stage<D> stage[block];
+    for (std::size_t v = 0; v < vectors; ++v) {
+      const std::size_t at = i + v * lanes, count = std::min(lanes, n - at);
+      js_load<Scaled>(a, p + at, count, pre_p, inv_p);
+      js_load<Scaled>(b, q + at, count, pre_q, inv_q);
+      js_prepare<D, U>(stage[v], a, b, wp, wq);
+    }
+    for (std::size_t v = 0; v < vectors; ++v) js_finish(acc, v, stage[v]);
   }
   double lane[4];
   static_assert(sizeof acc == sizeof lane);
@@ -175,11 +207,35 @@ inline bool js_cpu_has_avx2() noexcept {
   static const bool yes = __builtin_cpu_supports("avx2");
   return yes;
 }
+// And on 8-lane vectors where the CPU has AVX-512F (define INFOLERP_NO_AVX512 to disable).
+// AVX-512F implies FMA, and GCC and Clang would contract a·b + c into it (other bits than the
+// portable kernel): contraction is off in this function for GCC, and for the inlined helpers
+// under Clang (#pragma STDC FP_CONTRACT, here and in log2.hpp).
+#if !defined(INFOLERP_NO_AVX512)
+#define INFOLERP_JS_AVX512 1
+template <bool Scaled, class T>
+#if defined(__clang__)
+__attribute__((target("avx512f")))
+#else
+__attribute__((target("avx512f"), optimize("fp-contract=off")))
+#endif
+double js_kernel_avx512(const T* p, const T* q, std::size_t n, double wp, double pre_p, double inv_p, double pre_q,
+                        double inv_q) noexcept {
+  return js_kernel_on<js_v8d, js_v8u, Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
+}
+inline bool js_cpu_has_avx512() noexcept {
+  static const bool yes = __builtin_cpu_supports("avx512f");
+  return yes;
+}
+#endif
 #endif
 
 template <bool Scaled, class T>
 double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p = 1.0, double inv_p = 1.0,
                  double pre_q = 1.0, double inv_q = 1.0) noexcept {
+#ifdef INFOLERP_JS_AVX512
+  if (js_cpu_has_avx512()) return js_kernel_avx512<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
+#endif
 #ifdef INFOLERP_JS_AVX2
   if (js_cpu_has_avx2()) return js_kernel_avx2<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 #endif
@@ -278,6 +334,9 @@ double kl_lower_bound(const T* p, const double* q, std::size_t n) noexcept {
 }
 #if INFOLERP_JS_VECTOR
 #pragma GCC diagnostic pop
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT DEFAULT
+#endif
 #endif
 
 // Checks one user distribution and finds the factors that normalise it: x·pre·inv = x/Σx

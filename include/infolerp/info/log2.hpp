@@ -22,6 +22,9 @@ namespace infolerp::detail {
 #define INFOLERP_BIT_CAST(To, x) __builtin_bit_cast(To, x)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // 256-bit vectors only pass between inlined helpers
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF  // the same bits in the AVX-512 (FMA) kernels, see jensen_shannon.hpp
+#endif
 #else
 #define INFOLERP_LOG2_INLINE inline
 #define INFOLERP_BIT_CAST(To, x) std::bit_cast<To>(x)
@@ -56,6 +59,9 @@ INFOLERP_LOG2_INLINE void log2_reduce(log2_split<D>& out, const D& r) noexcept {
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT DEFAULT
+#endif
 #endif
 
 inline constexpr double log2_e = 1.4426950408889634074;
