@@ -57,13 +57,13 @@
 //     two finer grids both spend the same AO and soft-shadow work (25% and 6.3% of the pixels),
 //     and the margin (the sun rays the probes skip) is about the run-to-run noise.
 //   refined probes + agree() (AO and soft shadow within T, occlusion_within), against
-//     joint-bilateral in the same run, CPU time, five runs at load 1.5-3.2 (2 threads; wall
-//     times meaningless at that load; benchmarks/results/upsample_1025_tolerance.csv is the
-//     first): 1/2 grid (59.54 dB) beaten by 159 ids, min 2 sources, T 0.04, 4 passes (59.57 dB,
-//     8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%) with 27-29% less CPU; 1/4 (56.05 dB)
-//     by 159 ids, min 2, T 0.16, 4 passes (56.18 dB, 3.5%) with 10.6-11.5% less; 1/8 and
-//     1/16 by rows without agree() (159 ids, min 1, 4 passes: 7.6-13.4% less; 143 or 159 ids,
-//     5 passes: 9.1-16.2%, each below 10% in one run). Evaluations beyond the coarse grid sit
+//     joint-bilateral in the same run, time of the cheapest point with higher PSNR and SSIM,
+//     three idle runs, wall (benchmarks/results/upsample_1025_tolerance.csv is the first; five
+//     loaded runs in CPU time agree): 1/2 grid (59.54 dB) beaten by 159 ids, min 2 sources, T 0.04, 4 passes (59.57 dB,
+//     8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%) with 28.6-29.8% less time; 1/4 (56.05 dB)
+//     by 159 ids, min 2, T 0.16, 4 passes (56.18 dB, 3.5%) with 8.8-14.2% less; 1/8 and
+//     1/16 by rows without agree() (159 or 250 ids, min 1, 4 passes: 5.8-14.7% less; 143 or
+//     159 ids, 5 passes: 5.3-16.3%). Evaluations beyond the coarse grid sit
 //     near geometry, where occlusion and clusters change, and cost up to twice an average
 //     pixel's (--diagnose, plain I-Buffer, load ~1.6: 10.4 us per evaluation per thread at 3
 //     passes, 14.3 at 4, against 7.3 for the average pixel, sky included), so a tolerance buys
