@@ -135,8 +135,7 @@ struct contrast_source {
 struct occlusion_checked_source : sup::demo_ibuffer_source {
   float tolerance = 0.1f;
   bool compatible(const sample& a, const sample& b) const {
-    return infolerp::compatible(a, b) && std::abs(a.occlusion[0] - b.occlusion[0]) <= tolerance &&
-           std::abs(a.occlusion[1] - b.occlusion[1]) <= tolerance;
+    return infolerp::compatible(a, b) && infolerp::occlusion_within(a, b, tolerance);
   }
 };
 
@@ -182,7 +181,7 @@ class harness {
     for (int cells : {1, 2, 4}) clusterings.push_back(sup::cluster_by_normal(scene_, cells));
     clusterings.insert(clusterings.end(), coarser.begin(), coarser.end());
     clusterings.push_back(features);
-    std::vector<double> matched_fraction(7, 1.0);  // evaluated fraction of the feature clustering, per passes
+    std::vector<double> matched_fraction(7, 0.0);  // evaluated fraction of the feature clustering, per passes (0: row not run)
     for (const auto& c : clusterings) {
       // One pass (plain evaluation through the upsampler) only for the feature clustering; 6
       // passes only for the feature clusterings.
@@ -302,7 +301,13 @@ class harness {
       }
     }
     // (3) uniform low resolution + bilinear at the I-Buffer's evaluated fraction.
-    for (std::uint32_t passes = 2; passes <= 6 && want("lowres_bilinear"); ++passes) lowres_bilinear(matched_fraction[passes], passes);
+    for (std::uint32_t passes = 2; passes <= 6 && want("lowres_bilinear"); ++passes) {
+      if (matched_fraction[passes] > 0) {
+        lowres_bilinear(matched_fraction[passes], passes);
+      } else {  // --match left out the feature row whose cost this one matches
+        std::fprintf(stderr, "infolerp_pareto upsample: no lowres_bilinear row for %u passes: its feature I-Buffer row did not run\n", passes);
+      }
+    }
     // (4) joint-bilateral upsampling of the expensive terms from a 2^(p-1) grid.
     for (std::uint32_t passes = 2; passes <= 5 && want("joint_bilateral"); ++passes) joint_bilateral(1 << (passes - 1));
     return write(csv_path);
