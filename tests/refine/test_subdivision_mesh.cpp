@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -266,6 +267,24 @@ TEST_CASE("subdivision: two triangles of a square, by hand") {
     CHECK(subdivision_mesh::build(indexed_mesh{}).error().code() == infolerp::errc::empty_input);
     CHECK(subdivision_mesh::build(sq, {.bisect_ratio = -1.0f}).error().code() == infolerp::errc::bad_parameter);
   }
+}
+
+TEST_CASE("subdivision: midpoints of coordinates near FLT_MAX stay finite") {
+  // Found by fuzz_subdivision: 0.5 * (a + b) overflowed to infinity when both were near FLT_MAX.
+  const float big = std::numeric_limits<float>::max();
+  indexed_mesh m;
+  m.positions = {{big, big, 0}, {big, -big, 0}, {big, big, big}};
+  m.triangles = {{0, 1, 2}};
+  auto s = subdivision_mesh::build(m, {});
+  REQUIRE(s.ok());
+  REQUIRE(s->split(0u).ok());
+  REQUIRE(s->vertex_count() == 6);
+  for (std::size_t v = 0; v < s->vertex_count(); ++v) {
+    const glm::vec3 p = s->position(v);
+    CHECK((std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)));
+  }
+  CHECK(s->position(s->edge_midpoint(0, 2)) == glm::vec3(big, big, 0.5f * big));
+  CHECK(s->position(s->edge_midpoint(0, 1)) == glm::vec3(big, 0, 0));
 }
 
 TEST_CASE("subdivision: thousands of random selections on fandisk keep every invariant") {

@@ -425,7 +425,9 @@ class subdivision_mesh {
     const auto m = static_cast<std::uint32_t>(positions_.size());
     e.midpoint = m;
     if (e.face[0] != invalid_id) queue_.push_back({e.face[0], depth + 1});
-    positions_.push_back(0.5f * (positions_[a] + positions_[b]));
+    // Halves first: the sum of two coordinates near ±FLT_MAX overflows (a fuzz find); for
+    // normal numbers the result is the same bits as 0.5 * (a + b).
+    positions_.push_back(0.5f * positions_[a] + 0.5f * positions_[b]);
     vertex_source_.push_back(tris_[t].original);
     return m;
   }
