@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <new>
 #include <string>
 #include <vector>
@@ -193,6 +194,8 @@ struct refining : probing<Inner> {
   sample refine_probe(const sample& p, std::uint32_t x, std::uint32_t y) const {
     refinements.fetch_add(1, std::memory_order_relaxed);
     sample s = probing<Inner>::probe(x, y);
+    static std::mutex catch_assertions;  // refine_probe runs on worker threads; Catch2 v2 assertions are not thread-safe
+    const std::lock_guard<std::mutex> lock(catch_assertions);
     CHECK(s.cluster == p.cluster);
     return s;
   }
