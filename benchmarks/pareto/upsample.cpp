@@ -238,6 +238,12 @@ class harness {
       const sup::reference_shader primary_sun(scene_, po);
       po.hard_shadow = false;
       const sup::reference_shader primary(scene_, po);
+      auto refining = [&](sup::demo_refining_probe_source& src, const sup::scene_clustering* c) {
+        static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
+        src.primary = &primary;
+        src.probe_lights = false;
+        src.primary_sun = &primary_sun;
+      };
       std::vector<const sup::scene_clustering*> with{&features};
       for (const auto& c : coarser) with.push_back(&c);
       // The demo clustering with 2-6 passes (min_sources 1) and 2-4 (min_sources 2), the coarser ones with 4-6.
@@ -245,10 +251,7 @@ class harness {
         for (std::uint32_t min_sources = 1; min_sources <= (c == &features ? 2u : 1u); ++min_sources)
           for (std::uint32_t passes = c == &features ? 2 : 4; passes <= (min_sources == 1 ? 6u : 4u); ++passes) {
             sup::demo_refining_probe_source src;
-            static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
-            src.primary = &primary;
-            src.probe_lights = false;
-            src.primary_sun = &primary_sun;
+            refining(src, c);
             double f = 0;
             char setting[128];
             std::snprintf(setting, sizeof setting, "%s (%zu), probe primary, sun where needed, min %u src, %u passes", c->name.c_str(),
@@ -264,10 +267,7 @@ class harness {
           for (float tolerance : {0.02f, 0.04f, 0.08f, 0.16f})
             for (std::uint32_t passes = 2; passes <= 5; ++passes) {
               sup::demo_tolerant_probe_source src;
-              static_cast<sup::demo_ibuffer_source&>(src) = {&single_, c, w_, h_};
-              src.primary = &primary;
-              src.probe_lights = false;
-              src.primary_sun = &primary_sun;
+              refining(src, c);
               src.tolerance = tolerance;
               double f = 0;
               char setting[160];
