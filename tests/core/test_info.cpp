@@ -2,6 +2,7 @@
 // information, against closed forms and a long double reference.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <vector>
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/js_estimate.hpp"
 #include "infolerp/info/log2.hpp"
 
 namespace {
@@ -188,6 +190,93 @@ TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
     check(std::vector<float>(p.begin(), p.end()), std::vector<float>(q.begin(), q.end()), wp);
   }
   if (compared == 0) WARN("no AVX2 or AVX-512 kernel on this build or CPU: only the portable one ran");
+}
+
+TEST_CASE("log2 estimate: every float in [sqrt(1/2), sqrt(2)) within log2_estimate_error, every variant") {
+  // Exhaustive over the reduced range (8.4 million floats): the portable polynomial and the
+  // dispatched one (AVX2+FMA where the CPU has it), against long double.
+  using namespace infolerp::detail;
+  std::vector<float> x;
+  for (std::uint32_t bits = 0x3F3504F3u; bits < 0x3FB504F4u; ++bits) {
+    float f;
+    std::memcpy(&f, &bits, sizeof f);
+    if (f >= static_cast<float>(std::sqrt(0.5L)) && f < static_cast<float>(std::sqrt(2.0L))) x.push_back(f);
+  }
+  while (x.size() % 8) x.push_back(1.0f);
+  std::vector<float> dispatched(x.size()), portable(x.size());
+  log2_estimate(x.data(), dispatched.data(), x.size());
+  for (std::size_t i = 0; i < x.size(); i += 8) {
+#if INFOLERP_JSE_VECTOR
+    jse_vf v, l;
+    std::memcpy(&v, x.data() + i, sizeof v);
+    log2_estimate_on<jse_vf, jse_vi>(l, v);
+    std::memcpy(portable.data() + i, &l, sizeof l);
+#else
+    for (std::size_t j = i; j < i + 8; ++j) log2_estimate_on<float, std::int32_t>(portable[j], x[j]);
+#endif
+  }
+  long double worst_d = 0, worst_p = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const long double ref = std::log2(static_cast<long double>(x[i]));
+    worst_d = std::max(worst_d, std::fabs(dispatched[i] - ref));
+    worst_p = std::max(worst_p, std::fabs(portable[i] - ref));
+  }
+  INFO("worst dispatched " << static_cast<double>(worst_d) << ", portable " << static_cast<double>(worst_p));
+  CHECK(x.size() > 8000000);
+  CHECK(worst_d <= infolerp::log2_estimate_error);
+  CHECK(worst_p <= infolerp::log2_estimate_error);
+  CHECK(worst_p > 1e-8);  // the bound is not loose by orders of magnitude
+  // Outside the reduced range: the exponent is exact, zero and subnormals stay finite.
+  std::vector<float> y{1.0f, 2.0f, 0.5f, 1e-30f, 3e30f, 0.0f, 1e-40f, 1.17e-38f}, ly(8);
+  log2_estimate(y.data(), ly.data(), 8);
+  for (std::size_t i = 0; i < 5; ++i) CHECK(std::fabs(ly[i] - std::log2(static_cast<double>(y[i]))) <= 4e-6);
+  for (float l : ly) CHECK(std::isfinite(l));
+  CHECK(0.0f * ly[5] == 0.0f);
+}
+
+TEST_CASE("JS estimate: within js_estimate_error of the exact kernel on every shape of row") {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst_ratio = 0.0;
+  auto check = [&](const auto& p, const auto& q, double wp) {
+    const std::size_t n = p.size();
+    const double exact = infolerp::js_divergence(p, q, wp);
+    const double est = infolerp::js_estimate(p.data(), q.data(), n, wp, infolerp::entropy_estimate(p.data(), n),
+                                             infolerp::entropy_estimate(q.data(), n));
+    const double bound = infolerp::js_estimate_error(n);
+    INFO("n " << n << ", wp " << wp << ", exact " << exact << ", estimate " << est);
+    REQUIRE(std::fabs(est - exact) <= bound);
+    REQUIRE(est >= 0.0);
+    REQUIRE(est <= 1.0);
+    worst_ratio = std::max(worst_ratio, std::fabs(est - exact) / bound);
+  };
+  for (std::size_t n : {1u, 2u, 7u, 8u, 15u, 16u, 17u, 63u, 64u, 65u, 257u, 1000u, 4096u}) {
+    for (int trial = 0; trial < 40; ++trial) {
+      const double wp = trial % 10 == 0 ? 0.0 : trial % 10 == 1 ? 1.0 : u(rng);
+      auto p = random_distribution(n, rng, trial % 3 * 0.3), q = random_distribution(n, rng, trial % 2 * 0.5);
+      if (trial % 5 == 2) q = p;  // identical: JS 0
+      if (trial % 5 == 3)         // nearly identical
+        for (auto& x : q) x = std::nextafter(x, 1.0);
+      check(p, q, wp);
+      check(std::vector<float>(p.begin(), p.end()), std::vector<float>(q.begin(), q.end()), wp);
+    }
+    // One-hot rows on different bins (JS = h(wp)), and a row of subnormal-sized entries.
+    std::vector<double> a(n, 0.0), b(n, 0.0);
+    a[0] = 1.0;
+    b[n - 1] += 1.0;
+    check(a, b, 0.5);
+    check(a, b, 0.2);
+    if (n > 2) {
+      auto c = random_distribution(n, rng);
+      double sum = 0.0;
+      for (std::size_t i = 0; i < n; ++i) sum += (c[i] = i % 2 ? c[i] : 1e-39);
+      for (auto& x : c) x /= sum;
+      check(c, a, 0.5);
+      check(std::vector<float>(c.begin(), c.end()), std::vector<float>(a.begin(), a.end()), 0.5);
+    }
+  }
+  INFO("worst |estimate - exact| / bound " << worst_ratio);
+  CHECK(worst_ratio < 1.0);
 }
 
 TEST_CASE("JS checked API: clear errors naming the bin") {
