@@ -83,6 +83,45 @@ struct material_channel {
     return s;
   }
 };
+
+// A channel state with every member of S, estimate() only when Estimate, counting divergence()
+// calls: clustering without the estimate evaluates every divergence it would have decided.
+template <class S, bool Estimate>
+struct without_estimate {
+  S s;
+  std::size_t* divergences_evaluated;
+  std::size_t element_count() const { return s.element_count(); }
+  std::size_t class_count() const { return s.class_count(); }
+  std::uint32_t class_of(std::uint32_t i) const { return s.class_of(i); }
+  double mutual_information(std::uint32_t a) const { return s.mutual_information(a); }
+  double divergence(std::uint32_t a, std::uint32_t b) const {
+    ++*divergences_evaluated;  // the serial executor only
+    return s.divergence(a, b);
+  }
+  double estimate(std::uint32_t a, std::uint32_t b) const requires Estimate { return s.estimate(a, b); }
+  double estimate_error() const requires Estimate { return s.estimate_error(); }
+  bool all_alike() const requires requires(const S& x) { x.all_alike(); } { return s.all_alike(); }
+  bool surely_within(std::uint32_t a, std::uint32_t b, double th) const
+    requires requires(const S& x) { x.surely_within(a, b, th); } { return s.surely_within(a, b, th); }
+  double mutual_information_lower_bound(std::uint32_t a) const
+    requires requires(const S& x) { x.mutual_information_lower_bound(a); } { return s.mutual_information_lower_bound(a); }
+  std::uint32_t representative(std::uint32_t a) const
+    requires requires(const S& x) { x.representative(a); } { return s.representative(a); }
+  void prefetch(std::uint32_t a) const requires requires(const S& x) { x.prefetch(a); } { s.prefetch(a); }
+  void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const
+    requires requires(const S& x) { x.divergences(a, first, out); } { s.divergences(a, first, out); }
+};
+template <class P, bool Estimate>
+struct without_estimate_channel {
+  const P* p;
+  double threshold;
+  std::size_t* divergences_evaluated;
+  auto init(std::span<const std::uint32_t> tris) const -> result<without_estimate<channel_state_of<P>, Estimate>> {
+    auto st = p->init(tris);
+    if (!st) return st.error();
+    return without_estimate<channel_state_of<P>, Estimate>{std::move(*st), divergences_evaluated};
+  }
+};
 }  // namespace
 
 TEST_CASE("a cube splits into its 6 faces under orientation", "[cluster]") {
@@ -326,6 +365,58 @@ TEST_CASE("real meshes through Embree: three channels, coverage, connectivity, d
     REQUIRE(r->cluster_count >= r->channels[0].clusters_after);
     REQUIRE(r->cluster_count < m->triangles.size() / 4);
     if (std::string(name) == "fandisk") REQUIRE(run(serial)->cluster_of == r->cluster_of);
+  }
+}
+
+TEST_CASE("estimates change no result: Algorithm 1 with and without estimate()", "[cluster][real][estimate]") {
+  support::embree_device device;
+  auto m = support::load_mesh(support::cgal_mesh("fandisk"));
+  REQUIRE(m.ok());
+  support::embree_scene scene(device);
+  REQUIRE(scene.add_mesh(*m).ok());
+  REQUIRE(scene.commit().ok());
+  auto topo = build_topology(*m);
+  REQUIRE(topo.ok());
+  auto vis = visibility_channel{.viewpoints = 32, .samples_per_side = 1}.prepare(*m, *topo, scene, serial);
+  REQUIRE(vis.ok());
+  {  // the estimate is what the clustering uses
+    std::vector<std::uint32_t> all(m->triangles.size());
+    std::iota(all.begin(), all.end(), 0u);
+    auto st = vis->init(all);
+    REQUIRE(st.ok());
+    double worst = 0.0;
+    for (std::uint32_t a = 0; a < all.size(); a += 37)
+      for (std::uint32_t b = 0; b < all.size(); b += 101) worst = std::max(worst, std::abs(st->estimate(a, b) - st->divergence(a, b)));
+    REQUIRE(worst <= st->estimate_error());
+    REQUIRE(st->estimate_error() < 1e-4);
+  }
+  // Thresholds across the range (for visibility, orientation with stored binned rows).
+  for (const auto& [tv, to] : {std::pair{0.1, 0.01}, {0.3, 0.02}, {0.48, 0.05}, {0.7, 0.2}}) {
+    INFO("visibility Th " << tv << ", orientation Th " << to);
+    prepared_visibility_channel pv = *vis;
+    pv.threshold = tv;
+    auto po = orientation_channel{.threshold = to, .bins = 256}.prepare(*m, *topo, scene, serial);
+    REQUIRE(po.ok());
+    std::size_t evaluated_with[2] = {}, evaluated_without[2] = {};
+    auto with = cluster_mesh(*m, scene, serial, without_estimate_channel<prepared_visibility_channel, true>{&pv, tv, &evaluated_with[0]},
+                             without_estimate_channel<prepared_orientation_channel, true>{&*po, to, &evaluated_with[1]});
+    auto without = cluster_mesh(*m, scene, serial, without_estimate_channel<prepared_visibility_channel, false>{&pv, tv, &evaluated_without[0]},
+                                without_estimate_channel<prepared_orientation_channel, false>{&*po, to, &evaluated_without[1]});
+    REQUIRE(with.ok());
+    REQUIRE(without.ok());
+    REQUIRE(cluster_mesh(*m, scene, serial, pv, *po)->cluster_of == with->cluster_of);  // the wrapper changes nothing
+    INFO("divergences with / without the estimate: visibility " << evaluated_with[0] << " / " << evaluated_without[0]
+         << ", orientation " << evaluated_with[1] << " / " << evaluated_without[1]);
+    CHECK(evaluated_with[0] * 10 < evaluated_without[0]);
+    CHECK(evaluated_with[1] * 2 < evaluated_without[1]);
+    REQUIRE(with->cluster_count > 2);
+    REQUIRE(with->cluster_of == without->cluster_of);
+    for (std::size_t c = 0; c < 2; ++c) {
+      REQUIRE(with->channels[c].seeds == without->channels[c].seeds);
+      REQUIRE(with->channels[c].sequential_seeds == without->channels[c].sequential_seeds);
+      REQUIRE(with->channels[c].merged == without->channels[c].merged);
+      REQUIRE(with->channels[c].smoothed_triangles == without->channels[c].smoothed_triangles);
+    }
   }
 }
 

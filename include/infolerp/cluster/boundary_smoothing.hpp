@@ -56,7 +56,9 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 // neighbouring pair: O(min(|A|, |B|)) to find the boundary, O(band · log band) for the band and
 // the path, and O(|A| + |B|) only when a new path is tried (the split). Divergences only for
 // the boundary and band triangles, each JS(class, seed) once per set when clusters × classes
-// <= 2^20 (else once per pair), once per representative when the state has representative().
+// <= 2^20 (else once per pair), once per representative when the state has representative();
+// with the state's estimate(), estimates there, and divergences only where the two estimates'
+// error intervals overlap (the same comparisons as with exact values).
 // Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
 // 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
 // per-pair buffers are reused from pair to pair.
@@ -109,10 +111,15 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   // JS(class, seed of a cluster), memoised per (cluster, class) over all pairs when
   // clusters × classes <= 2^20 (binned direct channels), else per (side of the pair, class)
   // for the current pair only (an entry is valid when its stamp is `valid`).
+  // With the state's estimate() (error err), an entry first holds the estimate (exact[e] == 0)
+  // and is made exact only when the two estimates cannot decide the comparison.
   const std::size_t u = s.class_count();
   const bool dense = std::size_t{k} * u <= (std::size_t{1} << 20);
   std::vector<double> js((dense ? k : 2) * u);
   std::vector<std::uint32_t> stamp(js.size(), 0);
+  const double err = detail::estimate_error_of(s);
+  const bool estimated = err < std::numeric_limits<double>::infinity();
+  std::vector<std::uint8_t> exact(estimated ? js.size() : 0);
   std::uint32_t pair_index = 0;
   for (const auto& pair : pairs) {
     // Plain variables, not a structured binding: the lambda below captures them, which
@@ -174,18 +181,39 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     // 2. The band.
     const std::uint32_t cluster_a = ca, cluster_b = cb;  // clang++ 14 cannot capture a structured binding
     const std::uint32_t valid = dense ? 1u : pair_index;
-    auto js_to = [&](std::uint32_t c, std::uint32_t cluster, std::uint32_t side) {
+    // The memo slot of JS(class c, seed of cluster), filled (estimate or exact) on first use.
+    auto memo_slot = [&](std::uint32_t c, std::uint32_t cluster, std::uint32_t side) {
       const std::size_t e = (dense ? cluster : side) * u + c;
       if (stamp[e] != valid) {
         stamp[e] = valid;
+        if constexpr (detail::has_estimate<S>)
+          if (estimated) {
+            js[e] = s.estimate(c, s.class_of(r.seeds[cluster]));
+            exact[e] = 0;
+            return e;
+          }
         js[e] = s.divergence(c, s.class_of(r.seeds[cluster]));
       }
-      return js[e];
+      return e;
+    };
+    auto make_exact = [&](std::size_t e, std::uint32_t c, std::uint32_t cluster) {
+      if (estimated && !exact[e]) {
+        js[e] = s.divergence(c, s.class_of(r.seeds[cluster]));
+        exact[e] = 1;
+      }
     };
     auto prefers_other = [&](std::uint32_t i) {
       std::uint32_t c = s.class_of(i);
       if constexpr (detail::has_representative<S>) c = s.representative(c);  // bit-identical JS
-      const double js_a = js_to(c, cluster_a, 0), js_b = js_to(c, cluster_b, 1);
+      const std::size_t ea = memo_slot(c, cluster_a, 0), eb = memo_slot(c, cluster_b, 1);
+      if (estimated) {  // decided when the error intervals do not overlap
+        const double sa = exact[ea] ? 0.0 : err, sb = exact[eb] ? 0.0 : err;
+        if (js[eb] + sb < js[ea] - sa) return label[i] == cluster_a;
+        if (js[ea] + sa < js[eb] - sb) return label[i] != cluster_a;
+        make_exact(ea, c, cluster_a);
+        make_exact(eb, c, cluster_b);
+      }
+      const double js_a = js[ea], js_b = js[eb];
       return label[i] == cluster_a ? js_b < js_a : js_a < js_b;
     };
     band.clear();

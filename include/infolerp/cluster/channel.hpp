@@ -22,6 +22,8 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <numbers>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -29,6 +31,7 @@
 #include "infolerp/core/status.hpp"
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/js_estimate.hpp"
 
 namespace infolerp {
 
@@ -43,6 +46,10 @@ namespace infolerp {
 //   surely_within(a, b, th) -> bool: a cheap test, true only if divergence(a, b) <= th − 2⁻²²
 //       (false may mean either; the margin keeps the float JS columns of region growing on the
 //       same side of th); growth then needs the exact JS only where two seeds claim an element
+//   estimate(a, b) -> double and estimate_error() -> double: an estimate of divergence(a, b)
+//       within ±estimate_error() (absolute; +inf when the state has none), much cheaper;
+//       seeds, growth and boundary smoothing then evaluate divergence() only where the
+//       estimate cannot decide their comparison (same results, see region_growing.hpp)
 //   mutual_information_lower_bound(c) -> double: <= mutual_information(c) up to 1e-9; the first
 //       seed then evaluates MI only for classes whose bound can reach the smallest MI
 //   representative(c) -> class r <= c whose divergences to every class are bit-identical to
@@ -105,9 +112,10 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 //   double), column_count() (C), column_size(c) (elements in column c), mass(a, c) >= 0,
 //   total(a) = Σ_c mass(a, c).
 // Allocation: U·C doubles at construction when U·C <= max_stored_entries (65,536, 512 KB): the
-// rows built for Eq. (1) are kept and divergence(), divergences() and mutual_information() read
-// them without allocating; above that O(U + C), and those build their rows in up to 2C doubles
-// per call (small next to the O(C) work of building a row; no state is kept between calls).
+// rows built for Eq. (1) are kept (with U entropy estimates, which give estimate()) and
+// divergence(), divergences() and mutual_information() read them without allocating; above
+// that O(U + C), there is no estimate, and those build their rows in up to 2C doubles per call
+// (small next to the O(C) work of building a row; no state is kept between calls).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
@@ -118,11 +126,13 @@ class direct_channel_state {
     output_.assign(c, 0.0);
     if (u * c <= max_stored_entries) rows_.resize(u * c);
     std::vector<double> scratch_row(rows_.empty() ? c : 0);
+    if (!rows_.empty()) entropy_.resize(u);
     const double m = static_cast<double>(class_of_.size());
     // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U·C).
     for (std::uint32_t a = 0; a < u; ++a) {
       const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * c, c);
       row(a, r);
+      if (!entropy_.empty()) entropy_[a] = entropy_estimate(r.data(), c);
       const double w = kernel_.count(a) / m;
       for (std::size_t j = 0; j < c; ++j) output_[j] += w * r[j];
     }
@@ -153,10 +163,32 @@ class direct_channel_state {
     return element_mutual_information(row_of(a, buf), output_);
   }
 
+  // Pinsker's inequality, I(x;Y) = KL(row ‖ p(Y)) >= ‖row − p(Y)‖₁² / (2 ln 2) bits, without
+  // logarithms, when the rows are stored (else 0, which bounds nothing). O(C), no allocation.
+  double mutual_information_lower_bound(std::uint32_t a) const {
+    if (rows_.empty()) return 0.0;
+    const std::size_t c = kernel_.column_count();
+    const double* r = rows_.data() + a * c;
+    double l1 = 0.0;
+    for (std::size_t j = 0; j < c; ++j) l1 += std::abs(r[j] - output_[j]);
+    return l1 * l1 * (0.5 / std::numbers::ln2) * (1.0 - 1e-12);
+  }
+
   double divergence(std::uint32_t a, std::uint32_t b) const {
     if (a == b) return 0.0;
     std::vector<double> buf_a, buf_b;
     return js_divergence(row_of(a, buf_a), row_of(b, buf_b), 0.5);
+  }
+
+  // Within estimate_error() of divergence(a, b) (info/js_estimate.hpp) when the rows are
+  // stored; estimate_error() is +inf otherwise. O(C), no allocation.
+  double estimate(std::uint32_t a, std::uint32_t b) const {
+    if (a == b || entropy_.empty()) return 0.0;
+    const std::size_t c = kernel_.column_count();
+    return js_estimate(rows_.data() + a * c, rows_.data() + b * c, c, 0.5, entropy_[a], entropy_[b]);
+  }
+  double estimate_error() const {
+    return entropy_.empty() ? std::numeric_limits<double>::infinity() : js_estimate_error(kernel_.column_count());
   }
 
   // out[i] = divergence(a, first + i); the row of a is built once. O(C·out.size()).
@@ -187,6 +219,7 @@ class direct_channel_state {
   Kernel kernel_;
   std::vector<double> output_;
   std::vector<double> rows_;  // U × C when U·C <= max_stored_entries, else empty
+  std::vector<double> entropy_;  // entropy_estimate of each stored row (empty without rows_)
 };
 
 }  // namespace infolerp

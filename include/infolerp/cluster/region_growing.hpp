@@ -17,7 +17,13 @@
 //                (seed, class); with the state's surely_within, a candidate the bound puts
 //                within Th of the new seed is dropped without its JS (it could not be a seed
 //                any more), and growth evaluates JS exactly only where two seeds claim an
-//                element in the same ring. With the state's
+//                element in the same ring. With the state's estimate() (error e), an entry
+//                the estimate puts at most Th − e − 2⁻²² is bounded as above, one it puts above
+//                Th + e + 2⁻²² keeps the estimate (a float above Th) and its error in the
+//                candidate's summed JS, and the rest are exact; a seed is chosen among the
+//                candidates whose summed JS can still be the largest after their entries were
+//                made exact, so the seeds are those of exact columns. The sequential pass
+//                decides JS < Th by the estimate where it can. With the state's
 //                representative(), an entry whose representative is evaluated in the same
 //                batch is copied from it (bit-identical). Same result.
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
@@ -117,13 +123,58 @@ concept has_surely_within = requires(const S& s, std::uint32_t a, double th) {
   { s.surely_within(a, a, th) } -> std::convertible_to<bool>;
 };
 
+template <class S>
+concept has_estimate = requires(const S& s, std::uint32_t a) {
+  { s.estimate(a, a) } -> std::convertible_to<double>;
+  { s.estimate_error() } -> std::convertible_to<double>;
+};
+
+// The state's estimate error, +inf without estimate() (then nothing is decided by it).
+template <class S>
+double estimate_error_of(const S& s) {
+  if constexpr (has_estimate<S>) {
+    const double e = s.estimate_error();
+    return e >= 0.0 ? e : std::numeric_limits<double>::infinity();  // also NaN: unusable
+  } else {
+    return std::numeric_limits<double>::infinity();
+  }
+}
+
+// How the estimate places divergence(a, b) against th: +1 surely JS > th + 2⁻²² (so the float
+// of JS is > th too), -1 surely JS <= th − 2⁻²² (the float < th), 0 undecided.
+template <class S>
+int estimate_side(const S& s, std::uint32_t a, std::uint32_t b, double th, double err, double& e) {
+  if constexpr (has_estimate<S>) {
+    e = s.estimate(a, b);
+    if (e + err <= th - 0x1p-22) return -1;
+    if (e - err > th + 0x1p-22) return 1;
+  }
+  (void)s, (void)a, (void)b, (void)th, (void)err, (void)e;
+  return 0;
+}
+
+// is_similar(float(divergence(a, b)), th), by the estimate where it decides.
+template <class S>
+bool similar(const S& s, std::uint32_t a, std::uint32_t b, double th, double err) {
+  double e = 0.0;
+  if (err < std::numeric_limits<double>::infinity() && th < 1.0)
+    if (const int side = estimate_side(s, a, b, th, err, e)) return side < 0;
+  return is_similar(static_cast<float>(s.divergence(a, b)), th);
+}
+
 // col[c] = JS(a, c) for the classes c listed in `which` (ascending, distinct), in parallel chunks
 // (each slot independent). With a threshold (>= 0), js_bounded where the state's
-// surely_within(a, c, threshold) holds. Runs of consecutive classes go through the state's batch
+// surely_within(a, c, threshold) holds, or, with the state's estimate(), where the estimate
+// puts JS at most threshold − err − 2⁻²²; where it puts JS above threshold + err + 2⁻²² the
+// entry is the estimate (a float above threshold, within err + 2⁻²⁴ of the exact entry) and
+// approx[c] (when given) is 1, else 0. Runs of consecutive classes go through the state's batch
 // divergences() when it has one.
 template <class S, class E>
 void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, std::span<float> col, std::size_t grain,
-                E& exec, double threshold = -1.0) {
+                E& exec, double threshold = -1.0, std::span<std::uint8_t> approx = {}) {
+  const double err = threshold >= 0.0 && threshold < 1.0 ? estimate_error_of(s) : std::numeric_limits<double>::infinity();
+  if (!approx.empty())
+    for (std::uint32_t c : which) approx[c] = 0;
   // With the state's representative(): a class whose representative is also listed (and is
   // neither a nor the class itself) is marked js_copy and copies its entry afterwards
   // (bit-identical: same row). Representatives are never copies.
@@ -145,6 +196,14 @@ void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> whic
         ++i;
         continue;
       }
+      if (err < std::numeric_limits<double>::infinity()) {
+        double est = 0.0;
+        const int side = estimate_side(s, a, c, threshold, err, est);
+        col[c] = side < 0 ? js_bounded : side > 0 ? static_cast<float>(est) : static_cast<float>(s.divergence(a, c));
+        if (side > 0 && !approx.empty()) approx[c] = 1;
+        ++i;
+        continue;
+      }
       if constexpr (has_surely_within<S>) {
         col[c] = threshold >= 0.0 && s.surely_within(a, c, threshold) ? js_bounded : static_cast<float>(s.divergence(a, c));
         ++i;
@@ -161,7 +220,10 @@ void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> whic
   });
   if constexpr (has_representative<S>)
     for (std::uint32_t c : which)
-      if (col[c] == js_copy) col[c] = col[s.representative(c)];
+      if (col[c] == js_copy) {
+        col[c] = col[s.representative(c)];
+        if (!approx.empty()) approx[c] = approx[s.representative(c)];
+      }
 }
 
 // Renumbers clusters by their smallest element and drops empty ids; seeds follow.
@@ -193,8 +255,10 @@ inline void component_clusters(const element_graph& g, region_growing_result& r)
 // seeds are the same as with full columns). With the state's surely_within, entries the bound
 // decides (JS <= Th) are js_bounded and need no divergence: those classes are dropped anyway.
 // Preconditions: 0 < threshold < 1, class_count() >= 1.
-// Complexity: U MI evaluations + one divergence per (seed, class still a candidate), at most
-// U per seed. Allocation U floats per seed.
+// Complexity: U MI evaluations + one divergence (or estimate) per (seed, class still a
+// candidate), at most U per seed, plus with estimates one divergence per estimated entry of a
+// class that came within its error bound of the largest sum. Allocation U floats per seed
+// (and U bytes per seed with estimates).
 template <class S, class E>
 std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_t grain, E& exec,
                                         std::vector<std::vector<float>>& columns) {
@@ -226,21 +290,64 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
   std::vector<std::uint32_t> candidates(u);  // ascending
   std::iota(candidates.begin(), candidates.end(), 0u);
   columns.clear();
+  // With an estimate: slack[c] bounds |sum[c] − its exact value| (err + 2⁻²⁴ per estimated entry).
+  const double err = threshold < 1.0 ? detail::estimate_error_of(s) : std::numeric_limits<double>::infinity();
+  const bool estimated = err < std::numeric_limits<double>::infinity();
+  std::vector<double> slack(estimated ? u : 0, 0.0);
+  std::vector<std::vector<std::uint8_t>> approx;  // per seed: 1 where its entry is an estimate
+  // The estimated entries of c made exact (copied from its representative, a candidate too, made
+  // exact first); the sum recomputed in the same order (the same bits as if every entry had
+  // been exact from the start).
+  auto make_exact = [&](std::uint32_t c, auto& self) -> void {
+    std::uint32_t r = c;
+    if constexpr (detail::has_representative<S>) r = s.representative(c);
+    if (r != c && slack[r] > 0.0) self(r, self);
+    sum[c] = 0.0;
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      float& js = columns[k][c];
+      if (approx[k][c]) {
+        js = r != c ? columns[k][r] : static_cast<float>(s.divergence(seeds[k], c));
+        approx[k][c] = 0;
+      }
+      sum[c] += js;
+    }
+    slack[c] = 0.0;
+  };
   for (;;) {
     seeds.push_back(next);
     columns.emplace_back(u, detail::js_unknown);
     auto& col = columns.back();
-    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec, threshold);
+    if (estimated) approx.emplace_back(u, 0);
+    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec, threshold,
+                       estimated ? std::span<std::uint8_t>(approx.back()) : std::span<std::uint8_t>());
     std::uint32_t best = invalid_id;
     std::size_t kept = 0;
     for (std::uint32_t c : candidates) {
       sum[c] += col[c];
       if (!(static_cast<double>(col[c]) > threshold)) continue;
+      if (estimated && approx.back()[c]) slack[c] += err + 0x1p-24;
       candidates[kept++] = c;
       if (best == invalid_id || sum[c] > sum[best]) best = c;
     }
     candidates.resize(kept);
     if (best == invalid_id) break;
+    if (estimated) {
+      // Every candidate whose sum can reach best's lowest possible sum is made exact; the others
+      // are then strictly below best's exact sum, so the exact maximum (first on ties) is among
+      // the exact ones.
+      const double low = sum[best] - slack[best];
+      bool changed = false;
+      for (std::uint32_t c : candidates)
+        if (slack[c] > 0.0 && sum[c] + slack[c] >= low) {
+          make_exact(c, make_exact);
+          changed = true;
+        }
+      if (changed) {
+        best = invalid_id;
+        for (std::uint32_t c : candidates)
+          if (slack[c] == 0.0 && (best == invalid_id || sum[c] > sum[best])) best = c;
+      }
+    }
     next = best;
   }
   return seeds;
@@ -355,8 +462,9 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   columns.clear();
   columns.shrink_to_fit();
 
-  // Sequential pass over leftovers; JS to the current seed memoised per class (stamped).
-  std::vector<float> memo(u);
+  // Sequential pass over leftovers; "JS < Th" to the current seed memoised per class (stamped).
+  const double err = detail::estimate_error_of(s);
+  std::vector<std::uint8_t> memo(u);
   std::vector<std::uint32_t> stamp(u, invalid_id), queue;
   for (std::uint32_t e = 0; e < m; ++e) {
     if (label[e] != invalid_id) continue;
@@ -375,9 +483,9 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
         if (label[n] != invalid_id) continue;
         if (stamp[cls[n]] != k) {
           stamp[cls[n]] = k;
-          memo[cls[n]] = static_cast<float>(s.divergence(sc, cls[n]));
+          memo[cls[n]] = detail::similar(s, sc, cls[n], th, err) ? 1 : 0;
         }
-        if (!is_similar(memo[cls[n]], th)) continue;
+        if (!memo[cls[n]]) continue;
         label[n] = k;
         queue.push_back(n);
       }

@@ -46,6 +46,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/js_estimate.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
 
@@ -132,6 +133,17 @@ class visibility_state {
     if (ua || ub) return ua == ub ? 0.0 : 1.0;
     return js_channel(row(a), row(b), p_[a], p_[b]);
   }
+  // Within estimate_error() of divergence(a, b) (info/js_estimate.hpp; the unseen cases are
+  // exact). O(N), no allocation.
+  double estimate(std::uint32_t a, std::uint32_t b) const {
+    if (a == b) return 0.0;
+    const bool ua = unseen(a), ub = unseen(b);
+    if (ua || ub) return ua == ub ? 0.0 : 1.0;
+    const double total = p_[a] + p_[b];  // the weight js_channel uses
+    return js_estimate(rows_.data() + std::size_t{a} * n_, rows_.data() + std::size_t{b} * n_, n_, p_[a] / total,
+                       entropy_[a], entropy_[b]);
+  }
+  double estimate_error() const { return js_estimate_error(n_); }
   // True only if divergence(a, b) <= threshold, decided without logarithms by the upper bound
   //   JS_π(P,Q) <= h(π)·Σ_{p>q}(p − q) + h(1 − π)·Σ_{q>p}(q − p) <= h_max·Σ|p − q|,
   // h(x) = −x·log₂x <= h_max = 1/(e·ln 2) ≈ 0.53074 (the per-bin term f(p,q) is convex and
@@ -189,13 +201,15 @@ class visibility_state {
   std::vector<double> p_;       // p(t)
   std::vector<double> output_;  // p(v)
   std::vector<std::uint32_t> rep_;  // representative(t)
+  std::vector<double> entropy_;     // entropy_estimate of each row (0 when unseen)
   bool all_alike_ = false;
 
-  // rep_ by an open-addressing hash table of rows (bit patterns of the row and of p(t)).
-  // O(M·N), allocation O(M).
+  // rep_ by an open-addressing hash table of rows (bit patterns of the row and of p(t)), and
+  // entropy_ (estimated once per representative). O(M·N), allocation O(M).
   void find_representatives() {
     const std::size_t m = p_.size();
     rep_.resize(m);
+    entropy_.resize(m);
     std::size_t size = 1;
     while (size < 2 * m) size *= 2;
     std::vector<std::uint32_t> table(size, invalid_id), home(m);
@@ -232,6 +246,7 @@ class visibility_state {
           break;
         }
       }
+      entropy_[t] = rep_[t] != t ? entropy_[rep_[t]] : unseen(t) ? 0.0 : entropy_estimate(r, n_);
     }
   }
 };
@@ -279,6 +294,7 @@ struct prepared_visibility_channel {
       s.rows_.assign(m * n, 0.0f);
       s.all_alike_ = true;
       s.rep_.assign(m, 0);
+      s.entropy_.assign(m, 0.0);
       return s;
     }
     const double pv = 1.0 / static_cast<double>(active);
