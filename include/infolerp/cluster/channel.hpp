@@ -111,11 +111,12 @@ inline bool is_similar(double js, double threshold) noexcept { return threshold 
 // Kernel requirements: class_count() (U row classes), count(a) (elements in row class a, as
 //   double), column_count() (C), column_size(c) (elements in column c), mass(a, c) >= 0,
 //   total(a) = Σ_c mass(a, c).
-// Allocation: U·C doubles at construction when U·C <= max_stored_entries (65,536, 512 KB): the
-// rows built for Eq. (1) are kept (with U entropy estimates, which give estimate()) and
-// divergence(), divergences() and mutual_information() read them without allocating; above
-// that O(U + C), there is no estimate, and those build their rows in up to 2C doubles per call
-// (small next to the O(C) work of building a row; no state is kept between calls).
+// Allocation: U·C doubles and U·C floats at construction when U·C <= max_stored_entries (65,536:
+// 768 KB): the rows built for Eq. (1) are kept (with a float copy and U entropy estimates for
+// estimate()) and divergence(), divergences() and mutual_information() read them without
+// allocating; above that O(U + C), there is no estimate, and those build their rows in up to
+// 2C doubles per call (small next to the O(C) work of building a row; no state is kept between
+// calls).
 // Thread-safe for concurrent const calls.
 template <class Kernel>
 class direct_channel_state {
@@ -126,18 +127,25 @@ class direct_channel_state {
     output_.assign(c, 0.0);
     if (u * c <= max_stored_entries) rows_.resize(u * c);
     std::vector<double> scratch_row(rows_.empty() ? c : 0);
-    if (!rows_.empty()) entropy_.resize(u);
+    if (!rows_.empty()) {
+      entropy_.resize(u);
+      rows_f_.resize(u * c);
+    }
     const double m = static_cast<double>(class_of_.size());
     // Eq. (1): p(c) = Σ_a p(a) row_a(c), p(a) = count(a)/M.  O(U·C).
     for (std::uint32_t a = 0; a < u; ++a) {
       const std::span<double> r = rows_.empty() ? std::span<double>(scratch_row) : std::span<double>(rows_.data() + a * c, c);
       row(a, r);
-      if (!entropy_.empty()) entropy_[a] = entropy_estimate(r.data(), c);
+      if (!entropy_.empty()) {
+        for (std::size_t j = 0; j < c; ++j) rows_f_[a * c + j] = static_cast<float>(r[j]);
+        entropy_[a] = entropy_estimate(rows_f_.data() + a * c, c);
+      }
       const double w = kernel_.count(a) / m;
       for (std::size_t j = 0; j < c; ++j) output_[j] += w * r[j];
     }
   }
-  // Up to this many row entries (U·C) the rows built for Eq. (1) are kept (512 KB at most).
+  // Up to this many row entries (U·C) the rows built for Eq. (1) are kept (768 KB at most, with
+  // their float copy).
   static constexpr std::size_t max_stored_entries = 256 * 256;
 
   std::size_t element_count() const { return class_of_.size(); }
@@ -185,7 +193,7 @@ class direct_channel_state {
   double estimate(std::uint32_t a, std::uint32_t b) const {
     if (a == b || entropy_.empty()) return 0.0;
     const std::size_t c = kernel_.column_count();
-    return js_estimate(rows_.data() + a * c, rows_.data() + b * c, c, 0.5, entropy_[a], entropy_[b]);
+    return js_estimate(rows_f_.data() + a * c, rows_f_.data() + b * c, c, 0.5, entropy_[a], entropy_[b]);
   }
   double estimate_error() const {
     return entropy_.empty() ? std::numeric_limits<double>::infinity() : js_estimate_error(kernel_.column_count());
@@ -219,7 +227,8 @@ class direct_channel_state {
   Kernel kernel_;
   std::vector<double> output_;
   std::vector<double> rows_;  // U × C when U·C <= max_stored_entries, else empty
-  std::vector<double> entropy_;  // entropy_estimate of each stored row (empty without rows_)
+  std::vector<float> rows_f_;    // rows_ rounded to float, read by estimate() (empty without rows_)
+  std::vector<double> entropy_;  // entropy_estimate of each row of rows_f_ (empty without rows_)
 };
 
 }  // namespace infolerp
