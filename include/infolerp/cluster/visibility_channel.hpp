@@ -19,6 +19,8 @@
 // without logarithms, see visibility_state::surely_within).
 // Rows that are bit-identical (row and p(t)) after denoising share their divergences through
 // visibility_state::representative (69k groups for 89k triangles on refined_elephant).
+// visibility_state::estimate (info/js_estimate.hpp, one entropy estimate per row at init) lets
+// the clustering decide nearly all its comparisons without the exact JS kernel.
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
@@ -314,7 +316,11 @@ struct prepared_visibility_channel {
         pt += pv * ptv[v];
       }
       s.p_[i] = pt;
-      for (std::size_t v = 0; v < n; ++v) row[v] = pt > 0.0 ? static_cast<float>(pv * ptv[v] / pt) : 0.0f;
+      if (pt > 0.0) {  // (the test hoisted out of the loop, so that it vectorises)
+        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(pv * ptv[v] / pt);
+      } else {
+        std::fill(row.begin(), row.end(), 0.0f);
+      }
       s.rows_.insert(s.rows_.end(), row.begin(), row.end());
     }
     if (denoise && threshold > 0.0) denoise_rows(triangles, s);
