@@ -8,32 +8,44 @@
 //                                   ARI >= 0.99 at >= 10x less time.
 //   BM_VisibilityChannel_Total / BM_VisibilityChannel_RaysOnly   the channel against the raw time
 //                                   of its own rays through the same tracer. Goal ≤ 1.3×.
+//   BM_Clustering_RefinedElephant_Counted/E   the same through support::counting_channel, with
+//                                   the JS estimate (E = 1) or without (E = 0: the baseline, exact
+//                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
-// Measured (CPU time, g++ 12 -O3 portable flags, shared 2-core dev VM, 2026-12-01):
+// Measured 2026-12-02 (CPU time, g++ 12 -O3 portable flags, one core of the shared 2-core AMD
+// EPYC VM: AVX2, no AVX-512, about 2x slower here than the Xeon VM of 2026-12-01):
+//   BM_Clustering_RefinedElephant   402 / 409 ms (median of 3, two alternating idle runs) against
+//     597 / 603 for the previous version (0604aaf) and 592 / 594 for Counted/0: -32%. Clusters
+//     bit-identical (34 / 1960 / 4248, cluster_of_fnv24 7619422 in all three). Exact JS
+//     evaluations per run, without -> with the estimate: visibility 274,125 -> 2,399,
+//     orientation 50,636 -> 11,435, stretch 65,386 -> 2,685 (the rest decided by estimates,
+//     6.2x cheaper than the exact kernel at 64 float bins, 3.7x at 257 double bins). Goal
+//     <= 150 ms NOT met. Where the time goes now (perf, self time): the estimates 14% (seed
+//     search 6%), boundary smoothing 16% (visibility 11%: mostly the split's flood fills, bound
+//     by memory), visibility init + denoising 9%, growth 8%, sorting 3.5%, direct-channel
+//     states 3%, topology and subset graphs 3%.
+// Measured 2026-12-01 (Xeon VM, AVX-512, before the estimate):
 //   BM_Clustering_RefinedElephant   280 / 282 / 287 ms CPU (median of 3 repetitions, 3 runs)
 //     against 306 / 306 / 304 for the previous version (ed66263, which measured 258-266 at
 //     load 0.4 earlier that day) in the same alternating runs at load 0.5-0.9: ~8% less;
-//     ~1070 ms before the issue-3 speed work. Clusters bit-identical (34 / 1960 / 4248, every
-//     cluster_of entry compared). Goal <= 150 ms NOT met. CPU per part (a harness mirroring
+//     ~1070 ms before the issue-3 speed work. CPU per part (a harness mirroring
 //     cluster_mesh, median of 6, load 0.9, previous version in brackets): validation and
 //     topology 8.4 (9.0); visibility 181 (204): init 53 (57, of which ~13 are page faults of
 //     its two fresh M×N float buffers), seeds + growth 70 (81: seed search ~43, rings ~19,
 //     sequential pass 5.8 (8.5)), smoothing 55 (63: band flood 23 with 73k JS, split floods
 //     16.5, A* 6.7); orientation 44 (45: growth 17, smoothing 23); stretch 10 prepare + 48
-//     run (init 9, growth 23, smoothing 11). Visibility JS evaluations (64 bins, ~158 ns each
-//     in cache by BM_JensenShannon_Float, ~300 ns in smoothing's band flood, rows from memory): seed search
-//     149k (+25k decided by surely_within, from 173k exact), growth 32k (+27k bounded, from
-//     52k), sequential 18k, smoothing 73k (63.5k distinct (class, cluster) pairs); bit-identical
-//     rows share their JS (69k groups for 89k rows); I(t;V) evaluated for ~1k rows; denoising
-//     decides nearly all its tests by a bound. Tried and not kept (measured): per-row tables of
+//     run (init 9, growth 23, smoothing 11). Tried and not kept (measured): per-row tables of
 //     log2 entries (one logarithm per bin: a 64-bin pair 189 -> 106 ns in cache, but the 35 MB
 //     table cost ~30 ms of init, mostly page faults, and the seed search gained ~5 ms as the
 //     rows then stream 3x the bytes; for the direct channels' rows it saved ~7 ms of growth and
 //     cost ~4.5 ms of stretch init); the log-free lower bound of I(x;Y) for the direct
 //     channels (no gain: stretch growth 22.6 -> 24.5 ms); the split of boundary smoothing by floods
 //     racing from the path (1.6x fewer triangles visited, 1.7x slower).
-//   Direct channels at K = 1024 (CPU, load 3.5; every figure in orientation_channel.hpp and
+//   Direct channels at K = 1024, 2026-12-02 on the EPYC VM (CPU, idle): orientation on fandisk
+//     exact 5.15 s, exact rows 88.5 ms (58x, ARI 0.997); stretch on the UV sphere exact 716 ms,
+//     exact rows 2.76 ms (259x, ARI 1).
+//   Direct channels at K = 1024 (Xeon VM, CPU, load 3.5; every figure in orientation_channel.hpp and
 //     stretch_channel.hpp): orientation on fandisk, exact rows ARI 0.997 at 52x less time than
 //     exact (29 ms against 1.52 s; per-cell rows 0.954); stretch on the UV sphere, exact rows
 //     ARI 1 at 187x (per-cell rows 0.66): goal met. The jittered torus (2304 triangles, 786
@@ -49,8 +61,10 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <type_traits>
 #include <vector>
 #include "infolerp/cluster/cluster_mesh.hpp"
+#include "support/counting_channel.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
@@ -132,6 +146,13 @@ double adjusted_rand_index(const std::vector<std::uint32_t>& a, const std::vecto
   return maximum == expected ? 1.0 : (sij - expected) / (maximum - expected);
 }
 
+// FNV-1a of cluster_of, 24 bits (exact in a counter): speed work must leave it unchanged.
+double fnv24(const std::vector<std::uint32_t>& labels) {
+  std::uint32_t h = 2166136261u;
+  for (std::uint32_t l : labels) h = (h ^ l) * 16777619u;
+  return static_cast<double>(h >> 8);
+}
+
 void BM_Clustering_RefinedElephant(benchmark::State& state) {
   auto& e = elephant();
   if (!e.ok) return state.SkipWithError("refined_elephant not found");
@@ -149,12 +170,42 @@ void BM_Clustering_RefinedElephant(benchmark::State& state) {
   for (std::size_t i = 0; i < last.channels.size(); ++i)
     state.counters["after_ch" + std::to_string(i)] = last.channels[i].clusters_after;
   state.counters["peak_rss_MB"] = peak_rss_mb();
-  // FNV-1a of cluster_of, 24 bits (exact in a counter): speed work must leave it unchanged.
-  std::uint32_t h = 2166136261u;
-  for (std::uint32_t l : last.cluster_of) h = (h ^ l) * 16777619u;
-  state.counters["cluster_of_fnv24"] = static_cast<double>(h >> 8);
+  state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
 }
 BENCHMARK(BM_Clustering_RefinedElephant)->Unit(benchmark::kMillisecond);
+
+// The same clustering through support::counting_channel: with the JS estimate (1) or without it
+// (0, the exact kernel for every comparison, the baseline), counting the exact divergences per
+// channel. The cluster_of hash must equal BM_Clustering_RefinedElephant's in both.
+void BM_Clustering_RefinedElephant_Counted(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  serial_executor exec;
+  mesh_clustering last;
+  std::size_t evaluated[3] = {};
+  auto run = [&](auto estimate) {
+    constexpr bool with = decltype(estimate)::value;
+    auto po = orientation_channel{.threshold = 0.02, .bins = 256}.prepare(e.mesh, e.topo, *e.tracer, exec);
+    auto ps = stretch_channel{.threshold = 0.1, .bins = 256}.prepare(e.mesh, e.topo, *e.tracer, exec);
+    return cluster_mesh(e.mesh, *e.tracer, exec, cluster_options{},
+                        support::counting_channel<prepared_visibility_channel, with>{&e.visibility, e.visibility.threshold, &evaluated[0]},
+                        support::counting_channel<prepared_orientation_channel, with>{&*po, 0.02, &evaluated[1]},
+                        support::counting_channel<prepared_stretch_channel, with>{&*ps, 0.1, &evaluated[2]});
+  };
+  for (auto _ : state) {
+    auto r = state.range(0) ? run(std::true_type{}) : run(std::false_type{});
+    if (!r) return state.SkipWithError(r.error().message().c_str());
+    last = std::move(*r);
+    benchmark::DoNotOptimize(last);
+  }
+  const auto per_run = [&](std::size_t n) { return static_cast<double>(n) / static_cast<double>(state.iterations()); };
+  state.counters["exact_js_visibility"] = per_run(evaluated[0]);
+  state.counters["exact_js_orientation"] = per_run(evaluated[1]);
+  state.counters["exact_js_stretch"] = per_run(evaluated[2]);
+  state.counters["clusters"] = last.cluster_count;
+  state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
+}
+BENCHMARK(BM_Clustering_RefinedElephant_Counted)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // One direct channel, exact (K = 0) against binned: time of init + clustering, JS error, ARI.
 // Args: K (0 = exact), rows (0 = per cell, 1 = exact rows over the cells).

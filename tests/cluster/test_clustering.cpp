@@ -17,6 +17,7 @@
 #include "infolerp/mesh/geometry.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
+#include "support/counting_channel.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
 
@@ -84,44 +85,6 @@ struct material_channel {
   }
 };
 
-// A channel state with every member of S, estimate() only when Estimate, counting divergence()
-// calls: clustering without the estimate evaluates every divergence it would have decided.
-template <class S, bool Estimate>
-struct without_estimate {
-  S s;
-  std::size_t* divergences_evaluated;
-  std::size_t element_count() const { return s.element_count(); }
-  std::size_t class_count() const { return s.class_count(); }
-  std::uint32_t class_of(std::uint32_t i) const { return s.class_of(i); }
-  double mutual_information(std::uint32_t a) const { return s.mutual_information(a); }
-  double divergence(std::uint32_t a, std::uint32_t b) const {
-    ++*divergences_evaluated;  // the serial executor only
-    return s.divergence(a, b);
-  }
-  double estimate(std::uint32_t a, std::uint32_t b) const requires Estimate { return s.estimate(a, b); }
-  double estimate_error() const requires Estimate { return s.estimate_error(); }
-  bool all_alike() const requires requires(const S& x) { x.all_alike(); } { return s.all_alike(); }
-  bool surely_within(std::uint32_t a, std::uint32_t b, double th) const
-    requires requires(const S& x) { x.surely_within(a, b, th); } { return s.surely_within(a, b, th); }
-  double mutual_information_lower_bound(std::uint32_t a) const
-    requires requires(const S& x) { x.mutual_information_lower_bound(a); } { return s.mutual_information_lower_bound(a); }
-  std::uint32_t representative(std::uint32_t a) const
-    requires requires(const S& x) { x.representative(a); } { return s.representative(a); }
-  void prefetch(std::uint32_t a) const requires requires(const S& x) { x.prefetch(a); } { s.prefetch(a); }
-  void divergences(std::uint32_t a, std::uint32_t first, std::span<float> out) const
-    requires requires(const S& x) { x.divergences(a, first, out); } { s.divergences(a, first, out); }
-};
-template <class P, bool Estimate>
-struct without_estimate_channel {
-  const P* p;
-  double threshold;
-  std::size_t* divergences_evaluated;
-  auto init(std::span<const std::uint32_t> tris) const -> result<without_estimate<channel_state_of<P>, Estimate>> {
-    auto st = p->init(tris);
-    if (!st) return st.error();
-    return without_estimate<channel_state_of<P>, Estimate>{std::move(*st), divergences_evaluated};
-  }
-};
 }  // namespace
 
 TEST_CASE("a cube splits into its 6 faces under orientation", "[cluster]") {
@@ -398,10 +361,10 @@ TEST_CASE("estimates change no result: Algorithm 1 with and without estimate()",
     auto po = orientation_channel{.threshold = to, .bins = 256}.prepare(*m, *topo, scene, serial);
     REQUIRE(po.ok());
     std::size_t evaluated_with[2] = {}, evaluated_without[2] = {};
-    auto with = cluster_mesh(*m, scene, serial, without_estimate_channel<prepared_visibility_channel, true>{&pv, tv, &evaluated_with[0]},
-                             without_estimate_channel<prepared_orientation_channel, true>{&*po, to, &evaluated_with[1]});
-    auto without = cluster_mesh(*m, scene, serial, without_estimate_channel<prepared_visibility_channel, false>{&pv, tv, &evaluated_without[0]},
-                                without_estimate_channel<prepared_orientation_channel, false>{&*po, to, &evaluated_without[1]});
+    auto with = cluster_mesh(*m, scene, serial, support::counting_channel<prepared_visibility_channel, true>{&pv, tv, &evaluated_with[0]},
+                             support::counting_channel<prepared_orientation_channel, true>{&*po, to, &evaluated_with[1]});
+    auto without = cluster_mesh(*m, scene, serial, support::counting_channel<prepared_visibility_channel, false>{&pv, tv, &evaluated_without[0]},
+                                support::counting_channel<prepared_orientation_channel, false>{&*po, to, &evaluated_without[1]});
     REQUIRE(with.ok());
     REQUIRE(without.ok());
     REQUIRE(cluster_mesh(*m, scene, serial, pv, *po)->cluster_of == with->cluster_of);  // the wrapper changes nothing
