@@ -1,6 +1,13 @@
 // Jensen–Shannon throughput (issue 2 goal: at least 200 million bins/s per core for double) next
 // to a naive std::log2 baseline, and validate_mesh throughput on refined_elephant.
 //   build/benchmarks/infolerp_bench --benchmark_filter='JensenShannon|ValidateMesh'
+// BM_JensenShannon_Column/<bins>/<estimate>: one row against 4096 rows (a seed's JS column, as
+// the clustering evaluates it), exact kernel (0) or js_estimate (1), with the estimate's worst
+// error over the column against its bound. 64 float bins are the visibility channel's rows,
+// 257 double bins the binned direct channels'. Measured (CPU, one core of the shared 2-core AMD
+// EPYC dev VM, 2026-12-02): 64 float bins 639 ns exact, 104 ns estimate (6.2x), worst error
+// 3.8e-7 against the bound 2.6e-5; 257 double bins 2.20 µs exact, 593 ns estimate (3.7x: the
+// conversion to float), worst 8.0e-7 against 6.4e-5.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -8,6 +15,7 @@
 #include <random>
 #include <vector>
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/js_estimate.hpp"
 #include "infolerp/mesh/validate.hpp"
 #include "support/mesh_io.hpp"
 
@@ -56,6 +64,44 @@ static void BM_JensenShannon_Naive(benchmark::State& state) { run_js<double, tru
 BENCHMARK(BM_JensenShannon)->Arg(1 << 10)->Arg(1 << 16)->Arg(1 << 20);
 BENCHMARK(BM_JensenShannon_Naive)->Arg(1 << 10)->Arg(1 << 16)->Arg(1 << 20);
 BENCHMARK(BM_JensenShannon_Float)->Arg(1 << 10)->Arg(1 << 16)->Arg(1 << 20);
+
+template <class T>
+void run_js_column(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const bool estimate = state.range(1) != 0;
+  constexpr std::size_t rows = 4096;
+  std::vector<T> table;
+  std::vector<double> h(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    const auto p = random_distribution<T>(n, r + 10);
+    table.insert(table.end(), p.begin(), p.end());
+    h[r] = infolerp::entropy_estimate(table.data() + r * n, n);
+  }
+  std::vector<double> col(rows);
+  auto column = [&](bool est) {
+    for (std::size_t r = 1; r < rows; ++r)
+      col[r] = est ? infolerp::js_estimate(table.data(), table.data() + r * n, n, 0.4, h[0], h[r])
+                   : infolerp::js_divergence(std::span<const T>(table.data(), n), std::span<const T>(table.data() + r * n, n), 0.4);
+  };
+  for (auto _ : state) {
+    column(estimate);
+    benchmark::DoNotOptimize(col.data());
+  }
+  std::vector<double> exact(rows);
+  column(false);
+  exact = col;
+  column(true);
+  double worst = 0.0;
+  for (std::size_t r = 1; r < rows; ++r) worst = std::max(worst, std::abs(col[r] - exact[r]));
+  state.counters["ns_per_pair"] = benchmark::Counter(static_cast<double>(rows - 1) * static_cast<double>(state.iterations()),
+                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["estimate_worst_error"] = worst;
+  state.counters["estimate_bound"] = infolerp::js_estimate_error(n);
+}
+static void BM_JensenShannon_Column_Float(benchmark::State& state) { run_js_column<float>(state); }
+static void BM_JensenShannon_Column_Double(benchmark::State& state) { run_js_column<double>(state); }
+BENCHMARK(BM_JensenShannon_Column_Float)->Args({64, 0})->Args({64, 1});
+BENCHMARK(BM_JensenShannon_Column_Double)->Args({257, 0})->Args({257, 1});
 
 static void BM_ValidateMesh(benchmark::State& state) {
   auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("refined_elephant"));

@@ -27,7 +27,11 @@
 // Speed: the portable build runs 8-float GNU vectors on SSE2; on x86-64 an AVX2+FMA copy is
 // chosen at run time (the bound holds for both; their bits may differ, which is why results
 // never depend on an estimate's value, only on decisions it proves). Measured
-// (BM_JensenShannon_Estimate, benchmarks/bench_info.cpp): see that benchmark's comment.
+// (BM_JensenShannon_Column_*, benchmarks/bench_info.cpp, one core of the shared 2-core AMD EPYC
+// dev VM, AVX2+FMA dispatched): a 64-bin float row pair 104 ns against 639 ns exact (6.2x), a
+// 257-bin double pair 593 ns against 2.2 µs (3.7x: the conversion to float; the direct
+// channels keep float copies of their rows for this). Worst error seen there: 3.8e-7 at 64
+// bins (bound 2.6e-5), 8.0e-7 at 257 (bound 6.4e-5).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
