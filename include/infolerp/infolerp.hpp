@@ -14,6 +14,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
+#include "infolerp/info/js_estimate.hpp"
 #include "infolerp/info/log2.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/curvature.hpp"
