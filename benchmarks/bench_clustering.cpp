@@ -25,6 +25,9 @@
 //     search 6%), boundary smoothing 16% (visibility 11%: mostly the split's flood fills, bound
 //     by memory), visibility init + denoising 9%, growth 8%, sorting 3.5%, direct-channel
 //     states 3%, topology and subset graphs 3%.
+//   BM_VisibilityChannel_Total 3968 ms, BM_VisibilityChannel_RaysOnly 3808 ms (9.57 M rays) in
+//     the same run: 1.04x (goal <= 1.3x). These two had been dropped by mistake in 7c583eb and
+//     are back.
 // Measured 2026-12-01 (Xeon VM, AVX-512, before the estimate):
 //   BM_Clustering_RefinedElephant   280 / 282 / 287 ms CPU (median of 3 repetitions, 3 runs)
 //     against 306 / 306 / 304 for the previous version (ed66263, which measured 258-266 at
@@ -304,5 +307,47 @@ void BM_StretchChannel(benchmark::State& state) {
                        0.005);
 }
 BENCHMARK(BM_StretchChannel)->Apply(direct_channel_args);
+
+void BM_VisibilityChannel_Total(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  serial_executor exec;
+  for (auto _ : state) {
+    auto p = elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec);
+    benchmark::DoNotOptimize(p);
+  }
+  state.counters["triangles"] = static_cast<double>(e.mesh.triangles.size());
+}
+BENCHMARK(BM_VisibilityChannel_Total)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+// The same rays, same chunks, same tracer: only the trace_occluded calls are timed.
+void BM_VisibilityChannel_RaysOnly(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  const visibility_setup su = elephant_visibility.setup(e.mesh);
+  const std::size_t nt = e.mesh.triangles.size(), g = elephant_visibility.grain;
+  std::vector<ray> rays;
+  std::vector<std::uint32_t> slots;
+  std::vector<std::uint8_t> out;
+  std::size_t count = 0;
+  for (auto _ : state) {
+    double seconds = 0.0;
+    count = 0;
+    for (std::size_t first = 0; first < nt; first += g) {
+      rays.clear();
+      slots.clear();
+      make_visibility_rays(e.mesh, su, first, std::min(nt, first + g), rays, slots);
+      out.resize(rays.size());
+      const auto t0 = std::chrono::steady_clock::now();
+      trace_occluded(*e.tracer, std::span<const ray>(rays), std::span<std::uint8_t>(out));
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      count += rays.size();
+      benchmark::DoNotOptimize(out.data());
+    }
+    state.SetIterationTime(seconds);
+  }
+  state.counters["rays"] = static_cast<double>(count);
+}
+BENCHMARK(BM_VisibilityChannel_RaysOnly)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
