@@ -87,6 +87,27 @@ TEST_CASE("orientation: identical normals share one class; a planar patch is all
   }
 }
 
+TEST_CASE("direct channel: Pinsker MI bound and estimate where rows are stored, none where not", "[cluster][orientation]") {
+  const auto m = support::make_icosphere(3);
+  const auto n = face_normals(m);
+  const auto binned = make_orientation_state(n, 256);  // rows stored (U·C <= 65,536)
+  REQUIRE(binned.class_count() * binned.kernel().column_count() <= binned.max_stored_entries);
+  REQUIRE(std::isfinite(binned.estimate_error()));
+  double largest_bound = 0.0;
+  for (std::uint32_t a = 0; a < binned.class_count(); ++a) {
+    const double bound = binned.mutual_information_lower_bound(a);
+    REQUIRE(bound <= binned.mutual_information(a) + 1e-12);
+    largest_bound = std::max(largest_bound, bound);
+    for (std::uint32_t b = 0; b < binned.class_count(); b += 7)
+      REQUIRE(std::abs(binned.estimate(a, b) - binned.divergence(a, b)) <= binned.estimate_error());
+  }
+  REQUIRE(largest_bound > 0.0);  // the bound decides something
+  const auto exact = make_orientation_state(n, 0);  // 1280 classes: rows not stored
+  REQUIRE(exact.class_count() * exact.kernel().column_count() > exact.max_stored_entries);
+  REQUIRE(exact.estimate_error() == std::numeric_limits<double>::infinity());
+  REQUIRE(exact.mutual_information_lower_bound(0) == 0.0);
+}
+
 TEST_CASE("orientation binned rows approach exact rows as K grows", "[cluster][orientation]") {
   const auto m = support::make_icosphere(3);
   const auto n = face_normals(m);
