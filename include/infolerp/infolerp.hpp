@@ -8,6 +8,7 @@
 #include "infolerp/cluster/stretch_channel.hpp"
 #include "infolerp/cluster/visibility_channel.hpp"
 #include "infolerp/core/executor.hpp"
+#include "infolerp/core/large_buffer.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"

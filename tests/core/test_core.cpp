@@ -3,9 +3,11 @@
 
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <numeric>
 #include <vector>
 #include "infolerp/core/executor.hpp"
+#include "infolerp/core/large_buffer.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
@@ -152,4 +154,25 @@ TEST_CASE("executors cover every index once, and chunked reductions do not depen
   int calls = 0;
   infolerp::serial_executor{}.parallel_for(0, 4, [&](std::size_t, std::size_t) { ++calls; });
   CHECK(calls == 0);
+}
+
+TEST_CASE("large_buffer_allocator: 2 MiB aligned from 4 MiB, values kept through growth and copies") {
+  using buffer = std::vector<float, infolerp::large_buffer_allocator<float>>;
+  const auto aligned = [](const buffer& b) { return reinterpret_cast<std::uintptr_t>(b.data()) % (std::size_t{2} << 20) == 0; };
+  buffer small(1000);
+  std::iota(small.begin(), small.end(), 0.0f);
+  CHECK(small[999] == 999.0f);
+  buffer b;
+  for (int i = 0; i < (3 << 20); ++i) b.push_back(static_cast<float>(i % 4099));  // 12 MiB, several reallocations
+  REQUIRE(b.size() * sizeof(float) >= (std::size_t{4} << 20));
+  CHECK(aligned(b));
+  bool same = true;
+  for (int i = 0; i < (3 << 20); ++i) same = same && b[static_cast<std::size_t>(i)] == static_cast<float>(i % 4099);
+  CHECK(same);
+  const buffer copy = b;
+  CHECK(aligned(copy));
+  CHECK(copy == b);
+  buffer moved = std::move(small);
+  CHECK(moved.size() == 1000);
+  CHECK(moved[500] == 500.0f);
 }

@@ -43,6 +43,7 @@
 #include <glm/vec3.hpp>
 #include "infolerp/cluster/channel.hpp"
 #include "infolerp/core/executor.hpp"
+#include "infolerp/core/large_buffer.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
@@ -199,7 +200,7 @@ class visibility_state {
  private:
   friend struct prepared_visibility_channel;
   std::size_t n_ = 0;
-  std::vector<float> rows_;     // M × N
+  std::vector<float, large_buffer_allocator<float>> rows_;  // M × N (huge pages where offered)
   std::vector<double> p_;       // p(t)
   std::vector<double> output_;  // p(v)
   std::vector<std::uint32_t> rep_;  // representative(t)
@@ -351,7 +352,8 @@ struct prepared_visibility_channel {
       const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
       return it != sorted.end() && it->first == t ? it->second : invalid_id;
     };
-    std::vector<float> out, row(n);
+    std::vector<float, large_buffer_allocator<float>> out;
+    std::vector<float> row(n);
     out.reserve(m * n);  // appended row by row: no M×N zero fill first
     std::vector<double> acc(n);
     for (std::uint32_t i = 0; i < m; ++i) {
