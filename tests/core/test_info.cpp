@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <type_traits>
 #include <vector>
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
@@ -193,8 +194,8 @@ TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
 }
 
 TEST_CASE("log2 estimate: every float in [sqrt(1/2), sqrt(2)) within log2_estimate_error, every variant") {
-  // Exhaustive over the reduced range (8.4 million floats): the portable polynomial and the
-  // dispatched one (AVX2+FMA where the CPU has it), against long double.
+  // Exhaustive over the reduced range (8.4 million floats): the portable polynomial, the
+  // dispatched one and each AVX2+FMA / AVX-512 copy the CPU can run, against long double.
   using namespace infolerp::detail;
   std::vector<float> x;
   for (std::uint32_t bits = 0x3F3504F3u; bits < 0x3FB504F4u; ++bits) {
@@ -215,16 +216,30 @@ TEST_CASE("log2 estimate: every float in [sqrt(1/2), sqrt(2)) within log2_estima
     for (std::size_t j = i; j < i + 8; ++j) log2_estimate_on<float, std::int32_t>(portable[j], x[j]);
 #endif
   }
-  long double worst_d = 0, worst_p = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const long double ref = std::log2(static_cast<long double>(x[i]));
-    worst_d = std::max(worst_d, std::fabs(dispatched[i] - ref));
-    worst_p = std::max(worst_p, std::fabs(portable[i] - ref));
-  }
+  auto worst = [&](const std::vector<float>& l) {
+    long double w = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) w = std::max(w, std::fabs(l[i] - std::log2(static_cast<long double>(x[i]))));
+    return w;
+  };
+  const long double worst_d = worst(dispatched), worst_p = worst(portable);
   INFO("worst dispatched " << static_cast<double>(worst_d) << ", portable " << static_cast<double>(worst_p));
   CHECK(x.size() > 8000000);
   CHECK(worst_d <= infolerp::log2_estimate_error);
   CHECK(worst_p <= infolerp::log2_estimate_error);
+  // Each compiled copy the CPU can run, not only the one dispatched.
+  std::vector<float> other(x.size());
+#ifdef INFOLERP_JSE_AVX2
+  if (jse_cpu_has_avx2_fma()) {
+    log2_estimate_avx2(x.data(), other.data(), x.size());
+    CHECK(static_cast<double>(worst(other)) <= infolerp::log2_estimate_error);
+  }
+#endif
+#ifdef INFOLERP_JSE_AVX512
+  if (js_cpu_has_avx512()) {
+    log2_estimate_avx512(x.data(), other.data(), x.size());
+    CHECK(static_cast<double>(worst(other)) <= infolerp::log2_estimate_error);
+  }
+#endif
   CHECK(worst_p > 1e-8);  // the bound is not loose by orders of magnitude
   // Outside the reduced range: the exponent is exact, zero and subnormals stay finite.
   std::vector<float> y{1.0f, 2.0f, 0.5f, 1e-30f, 3e30f, 0.0f, 1e-40f, 1.17e-38f}, ly(8);
@@ -249,6 +264,20 @@ TEST_CASE("JS estimate: within js_estimate_error of the exact kernel on every sh
     REQUIRE(est >= 0.0);
     REQUIRE(est <= 1.0);
     worst_ratio = std::max(worst_ratio, std::fabs(est - exact) / bound);
+    // The same estimate through each compiled copy of the kernel, not only the dispatched one.
+    using T = typename std::decay_t<decltype(p)>::value_type;
+    const auto through = [&](auto sum) {
+      const double h = -sum(p.data(), q.data(), n, static_cast<float>(wp), static_cast<float>(1.0 - wp));
+      const double hp = -sum(p.data(), nullptr, n, 1.0f, 0.0f), hq = -sum(q.data(), nullptr, n, 1.0f, 0.0f);
+      REQUIRE(std::fabs(std::clamp(h - (wp * hp + (1.0 - wp) * hq), 0.0, 1.0) - exact) <= bound);
+    };
+    through(infolerp::detail::xlogx_sum_on<infolerp::detail::jse_vf, infolerp::detail::jse_vi, T>);
+#ifdef INFOLERP_JSE_AVX2
+    if (infolerp::detail::jse_cpu_has_avx2_fma()) through(infolerp::detail::xlogx_sum_avx2<T>);
+#endif
+#ifdef INFOLERP_JSE_AVX512
+    if (infolerp::detail::js_cpu_has_avx512()) through(infolerp::detail::xlogx_sum_avx512<T>);
+#endif
   };
   for (std::size_t n : {1u, 2u, 7u, 8u, 15u, 16u, 17u, 63u, 64u, 65u, 257u, 1000u, 4096u}) {
     for (int trial = 0; trial < 40; ++trial) {
