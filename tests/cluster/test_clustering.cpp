@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -423,4 +424,26 @@ TEST_CASE("boundary smoothing straightens a jagged boundary and never touches a 
   for (std::size_t t = 0; t < n; ++t) REQUIRE((before[t] == 2) == (r.cluster_of[t] == 2));
   mesh_clustering mc{r.cluster_of, 3, {}};
   check_invariants(m, mc);
+}
+
+TEST_CASE("boundary smoothing's key sort orders like std::sort at every size and key shape", "[cluster][smoothing]") {
+  std::mt19937_64 rng(5);
+  std::vector<std::uint64_t> scratch;
+  for (std::size_t n : {0u, 1u, 2u, 255u, 256u, 257u, 1000u, 4097u}) {
+    for (int shape = 0; shape < 4; ++shape) {
+      std::vector<std::uint64_t> keys(n);
+      for (auto& k : keys) {
+        const std::uint64_t r = rng();
+        k = shape == 0 ? r                                                     // every byte varies
+            : shape == 1 ? ((r & 0xffff) << 32) | (r >> 20 & 0xffff)           // edge keys of a small mesh
+            : shape == 2 ? 0x0102030405060708ull                               // all equal
+                         : (r & 1) << 63 | 0x00ff00ff00000000ull | (r >> 8 & 0xff);  // top bit and one low byte
+      }
+      auto expected = keys;
+      std::sort(expected.begin(), expected.end());
+      infolerp::detail::sort_keys(keys, scratch);
+      INFO("n " << n << ", shape " << shape);
+      CHECK(keys == expected);
+    }
+  }
 }
