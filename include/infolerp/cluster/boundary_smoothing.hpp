@@ -19,7 +19,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <iterator>
 #include <limits>
 #include <span>
 #include <utility>
@@ -120,7 +119,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   for (std::uint32_t i = 0; i < n; ++i) members_of[label[i]].push_back(i);
 
   std::uint32_t moved = 0;
-  std::vector<std::uint32_t> region(n, invalid_id), stack, members;
+  std::vector<std::uint32_t> region(n, invalid_id), stack(n), members;
   // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
   std::vector<std::uint64_t> boundary, edges, path, end_keys, key_scratch;
   std::vector<std::uint32_t> frontier, far_side, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
@@ -353,9 +352,9 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     };
 
     // 4. Split A ∪ B along the path.
-    members.clear();
+    members.resize(members_of[ca].size() + members_of[cb].size());
     std::merge(members_of[ca].begin(), members_of[ca].end(), members_of[cb].begin(), members_of[cb].end(),
-               std::back_inserter(members));
+               members.begin());
     // Flood fill of A ∪ B (members marked `unvisited`) without crossing the path, stopped as
     // soon as the split cannot be kept: a first region holding both seeds, or a third region.
     constexpr std::uint32_t unvisited = invalid_id - 1;
@@ -369,16 +368,16 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         break;
       }
       region[i] = regions;
-      stack.push_back(i);
-      while (!stack.empty()) {
-        const std::uint32_t t = stack.back();
-        stack.pop_back();
+      std::size_t top = 0;  // each element enters the stack once (marked first): n slots suffice
+      stack[top++] = i;
+      while (top > 0) {
+        const std::uint32_t t = stack[--top];
         for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
           const std::uint32_t j = g.neighbours[slot];
           if (region[j] != unvisited) continue;
           if (slot_edge[slot] != no_edge && on_path(slot_edge[slot])) continue;
           region[j] = regions;
-          stack.push_back(j);
+          stack[top++] = j;
         }
       }
       if (region[r.seeds[ca]] == regions && region[r.seeds[cb]] == regions) {
