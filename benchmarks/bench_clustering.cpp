@@ -13,6 +13,22 @@
 //                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
+// Measured 2026-12-02, later (CPU time, one core of another 2-core AMD EPYC VM, with AVX-512,
+// ~25% steal time: single runs vary by +-15%, so min and median over alternating runs):
+//   BM_Clustering_RefinedElephant   min 148.2 / median 155.7 ms over 36 runs against 171.1 /
+//     188.2 for the previous version (22fc459), alternating, same clusters (cluster_of_fnv24
+//     7619422). Goal <= 150 ms met in the quieter runs only. The steps, each measured against
+//     the one before: large_buffer_allocator for the visibility rows (page faults 159k -> 32k
+//     per process, 181-188 -> 161-162 ms), the AVX-512 copy of the JS estimate (64 float bins
+//     24.4 -> 19.8-20.9 ns a pair), the radix key sort in boundary smoothing (std::sort had ~6%),
+//     the split's flood stack sized once (an out-of-line push_back had ~2%). Peak RSS 107 MB
+//     (94 before: whole 2 MiB pages). Counted/0 184 ms, Counted/1 171 ms in one run (the exact
+//     kernel is itself AVX-512 here). Tried and not kept (perf share, no gain): denoising in
+//     place with delayed write-back (34k of 89k rows pending: the mesh order is not local;
+//     slower), marking the path's graph slots for the split's flood instead of the edge-key
+//     filter (smoothing 8.9% -> 10.8%), prefetching p(t) with the rows.
+//   BM_VisibilityChannel_Total 1665 ms, BM_VisibilityChannel_RaysOnly 1540 ms wall (1590 CPU)
+//     in one run: 1.08x (goal <= 1.3x).
 // Measured 2026-12-02 (CPU time, g++ 12 -O3 portable flags, one core of the shared 2-core AMD
 // EPYC VM: AVX2, no AVX-512, about 2x slower here than the Xeon VM of 2026-12-01):
 //   BM_Clustering_RefinedElephant   402 / 409 ms (median of 3, two alternating idle runs) against

@@ -32,7 +32,7 @@
 // row against 4096): on the AMD EPYC VM without AVX-512 (AVX2+FMA), a 64-bin float row pair
 // 104 ns against 639 ns exact (6.2x), a 257-bin double pair 593 ns against 2.2 µs (3.7x: the
 // conversion to float; the direct channels keep float copies of their rows for this); on the
-// AMD EPYC VM with AVX-512 of 2026-12-02, 64 float bins 24.4 -> 19.8 ns with the AVX-512 copy
+// AMD EPYC VM with AVX-512 of 2026-12-02, 64 float bins 24.4 -> 19.8-20.9 ns with the AVX-512 copy
 // (exact 92 ns), 257 double bins 650 -> 353 ns (exact 339 ns, itself on AVX-512: for double
 // rows the estimate is no faster there). Worst error seen: 3.8e-7 at 64 bins (bound 2.6e-5),
 // 8.0e-7 at 257 (bound 6.4e-5).
