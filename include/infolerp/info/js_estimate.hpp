@@ -152,6 +152,19 @@ INFOLERP_LOG2_INLINE double xlogx_sum_on(const T* p, const T* q, std::size_t n, 
   return sum[0];
 }
 
+// out[j] = log2_estimate_on(x[j]) for j from i, a vector at a time while one fits; returns
+// where it stopped.
+template <class V, class I>
+INFOLERP_LOG2_INLINE std::size_t log2_estimate_from(const float* x, float* out, std::size_t i, std::size_t n) noexcept {
+  for (; i + sizeof(V) / sizeof(float) <= n; i += sizeof(V) / sizeof(float)) {
+    V v, l;
+    std::memcpy(&v, x + i, sizeof v);
+    log2_estimate_on<V, I>(l, v);
+    std::memcpy(out + i, &l, sizeof l);
+  }
+  return i;
+}
+
 #if INFOLERP_JSE_VECTOR
 #pragma GCC diagnostic pop
 #endif
@@ -164,12 +177,7 @@ __attribute__((target("avx2,fma"))) double xlogx_sum_avx2(const T* p, const T* q
   return xlogx_sum_on<jse_vf, jse_vi>(p, q, n, wp, wq);
 }
 __attribute__((target("avx2,fma"))) inline void log2_estimate_avx2(const float* x, float* out, std::size_t n) noexcept {
-  for (std::size_t i = 0; i + 8 <= n; i += 8) {
-    jse_vf v, l;
-    std::memcpy(&v, x + i, sizeof v);
-    log2_estimate_on<jse_vf, jse_vi>(l, v);
-    std::memcpy(out + i, &l, sizeof l);
-  }
+  log2_estimate_from<jse_vf, jse_vi>(x, out, 0, n);
 }
 inline bool jse_cpu_has_avx2_fma() noexcept {
   static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
@@ -187,19 +195,7 @@ __attribute__((target("avx512f"))) double xlogx_sum_avx512(const T* p, const T* 
   return xlogx_sum_on<jse_vf16, jse_vi16>(p, q, n, wp, wq);
 }
 __attribute__((target("avx512f"))) inline void log2_estimate_avx512(const float* x, float* out, std::size_t n) noexcept {
-  std::size_t i = 0;
-  for (; i + 16 <= n; i += 16) {
-    jse_vf16 v, l;
-    std::memcpy(&v, x + i, sizeof v);
-    log2_estimate_on<jse_vf16, jse_vi16>(l, v);
-    std::memcpy(out + i, &l, sizeof l);
-  }
-  for (; i + 8 <= n; i += 8) {
-    jse_vf v, l;
-    std::memcpy(&v, x + i, sizeof v);
-    log2_estimate_on<jse_vf, jse_vi>(l, v);
-    std::memcpy(out + i, &l, sizeof l);
-  }
+  log2_estimate_from<jse_vf, jse_vi>(x, out, log2_estimate_from<jse_vf16, jse_vi16>(x, out, 0, n), n);
 }
 #endif
 
@@ -223,16 +219,7 @@ inline void log2_estimate(const float* x, float* out, std::size_t n) noexcept {
 #ifdef INFOLERP_JSE_AVX2
   if (jse_cpu_has_avx2_fma()) return log2_estimate_avx2(x, out, n);
 #endif
-  for (std::size_t i = 0; i + 8 <= n; i += 8) {
-#if INFOLERP_JSE_VECTOR
-    jse_vf v, l;
-    std::memcpy(&v, x + i, sizeof v);
-    log2_estimate_on<jse_vf, jse_vi>(l, v);
-    std::memcpy(out + i, &l, sizeof l);
-#else
-    for (std::size_t j = i; j < i + 8; ++j) log2_estimate_on<float, std::int32_t>(out[j], x[j]);
-#endif
-  }
+  log2_estimate_from<jse_vf, jse_vi>(x, out, 0, n);
 }
 
 }  // namespace detail
