@@ -21,8 +21,8 @@
 //     the one before: large_buffer_allocator for the visibility rows (page faults 159k -> 32k
 //     per process, 181-188 -> 161-162 ms), the AVX-512 copy of the JS estimate (64 float bins
 //     24.4 -> 19.8-20.9 ns a pair), the radix key sort in boundary smoothing (std::sort had ~6%),
-//     and the split's flood stack sized once (no gain measured: the out-of-line push_back,
-//     ~1.8%, comes from other sites). Peak RSS 107 MB
+//     and the split's merged member list written in place (std::merge into a sized vector).
+//     A flood stack sized once gave no measurable gain and was taken out again. Peak RSS 107 MB
 //     (94 before: whole 2 MiB pages). Counted/0 184 ms, Counted/1 171 ms in one run (the exact
 //     kernel is itself AVX-512 here). Tried and not kept (perf share, no gain): denoising in
 //     place with delayed write-back (34k of 89k rows pending: the mesh order is not local;

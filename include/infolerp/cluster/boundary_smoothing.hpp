@@ -119,7 +119,7 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   for (std::uint32_t i = 0; i < n; ++i) members_of[label[i]].push_back(i);
 
   std::uint32_t moved = 0;
-  std::vector<std::uint32_t> region(n, invalid_id), stack(n), members;
+  std::vector<std::uint32_t> region(n, invalid_id), stack, members;
   // Per-pair buffers, reused (cleared, not reallocated) from pair to pair.
   std::vector<std::uint64_t> boundary, edges, path, end_keys, key_scratch;
   std::vector<std::uint32_t> frontier, far_side, ends, endpoints, band, verts, end_vertex, adj_offsets, adj, from;
@@ -368,16 +368,16 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         break;
       }
       region[i] = regions;
-      std::size_t top = 0;  // each element enters the stack once (marked first): n slots suffice
-      stack[top++] = i;
-      while (top > 0) {
-        const std::uint32_t t = stack[--top];
+      stack.push_back(i);
+      while (!stack.empty()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
         for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
           const std::uint32_t j = g.neighbours[slot];
           if (region[j] != unvisited) continue;
           if (slot_edge[slot] != no_edge && on_path(slot_edge[slot])) continue;
           region[j] = regions;
-          stack[top++] = j;
+          stack.push_back(j);
         }
       }
       if (region[r.seeds[ca]] == regions && region[r.seeds[cb]] == regions) {
