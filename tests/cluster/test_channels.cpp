@@ -215,6 +215,30 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
     REQUIRE(row == Approx(1.0).epsilon(1e-5));
   }
   REQUIRE(total == Approx(1.0));
+  // p(t|v) = OR(t,v) / Σ_t' OR(t',v), p(v) = 1/N_active, p(t) = Σ_v p(v) p(t|v) and
+  // p(v|t) = p(v) p(t|v) / p(t), written out from occlusion_ratio: on the whole scene, and on
+  // the floor alone, which the viewpoints below it do not see (N_active < N).
+  auto check_bayes = [&](std::span<const std::uint32_t> set, bool all_active) {
+    auto st = p->init(set);
+    REQUIRE(st.ok());
+    std::vector<double> weight(p->viewpoints, 0.0);
+    for (std::uint32_t t : set)
+      for (std::size_t v = 0; v < p->viewpoints; ++v) weight[v] += p->occlusion_ratio(t, v);
+    const auto active = std::count_if(weight.begin(), weight.end(), [](double w) { return w > 0.0; });
+    REQUIRE((static_cast<std::size_t>(active) == p->viewpoints) == all_active);
+    for (std::uint32_t i = 0; i < set.size(); ++i) {
+      double pt = 0.0;
+      for (std::size_t v = 0; v < p->viewpoints; ++v)
+        if (weight[v] > 0.0) pt += p->occlusion_ratio(set[i], v) / weight[v] / static_cast<double>(active);
+      REQUIRE(st->input_probability(i) == Approx(pt).epsilon(1e-12).margin(1e-300));
+      for (std::size_t v = 0; v < p->viewpoints; ++v) {
+        const double want = pt > 0.0 && weight[v] > 0.0 ? p->occlusion_ratio(set[i], v) / weight[v] / static_cast<double>(active) / pt : 0.0;
+        REQUIRE(static_cast<double>(st->row(i)[v]) == Approx(want).epsilon(1e-6).margin(1e-12));
+      }
+    }
+  };
+  check_bayes(tris, true);
+  check_bayes(std::span<const std::uint32_t>(tris).first(floor_count), false);
   // The sealed triangles are unseen: their own class.
   REQUIRE(s->unseen(static_cast<std::uint32_t>(inner)));
   REQUIRE(s->unseen(static_cast<std::uint32_t>(inner + 1)));

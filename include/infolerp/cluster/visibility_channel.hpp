@@ -279,16 +279,16 @@ struct prepared_visibility_channel {
     const std::size_t nt = neighbour_offsets.empty() ? 0 : neighbour_offsets.size() - 1;
     for (std::uint32_t t : triangles)
       if (t >= nt) return make_error(errc::index_out_of_range, t, "visibility channel: triangle ", t, " out of range");
-    // OR takes samples + 1 values: tabled (the same bits as occlusion_ratio, no division per entry).
-    std::vector<double> ratio(std::size_t{samples} + 1);
-    for (std::uint32_t c = 0; c <= samples; ++c) ratio[c] = static_cast<double>(c) / static_cast<double>(samples);
-    std::vector<double> weight(n, 0.0);  // Σ_t OR(t, v)
+    // p(t|v) = OR(t,v) / Σ_t' OR(t',v) = c(t,v) / C(v) with c the visible-sample counts and
+    // C(v) = Σ_t' c(t',v), an exact integer. With p(v) = 1/N_active on the viewpoints of C(v) > 0,
+    // p(t) = p(v)·S(t) and p(v|t) = p(v) p(t|v) / p(t) = p(t|v) / S(t), S(t) = Σ_v p(t|v).
+    std::vector<std::uint64_t> total(n, 0);
     for (std::uint32_t t : triangles) {
       const std::uint8_t* vis = visible.data() + std::size_t{t} * n;
-      for (std::size_t v = 0; v < n; ++v) weight[v] += ratio[vis[v]];
+      for (std::size_t v = 0; v < n; ++v) total[v] += vis[v];
     }
     std::size_t active = 0;
-    for (double w : weight) active += w > 0.0 ? 1 : 0;
+    for (std::uint64_t c : total) active += c > 0 ? 1 : 0;
     visibility_state s;
     s.n_ = n;
     s.p_.assign(m, 0.0);
@@ -301,24 +301,28 @@ struct prepared_visibility_channel {
       return s;
     }
     const double pv = 1.0 / static_cast<double>(active);
-    for (std::size_t v = 0; v < n; ++v) s.output_[v] = weight[v] > 0.0 ? pv : 0.0;
-    // p(t|v) = OR(t,v) / weight[v] also takes few values: tabled per (visible count, v).
-    std::vector<double> ptv_of((std::size_t{samples} + 1) * n);
-    for (std::uint32_t c = 0; c <= samples; ++c)
-      for (std::size_t v = 0; v < n; ++v) ptv_of[c * n + v] = weight[v] > 0.0 ? ratio[c] / weight[v] : 0.0;
+    std::vector<double> inv_total(n, 0.0);  // 1 / C(v), 0 where C(v) = 0
+    for (std::size_t v = 0; v < n; ++v)
+      if (total[v] > 0) {
+        s.output_[v] = pv;
+        inv_total[v] = 1.0 / static_cast<double>(total[v]);
+      }
     std::vector<double> ptv(n);
     std::vector<float> row(n);
     s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
     for (std::size_t i = 0; i < m; ++i) {
       const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
-      double pt = 0.0;
-      for (std::size_t v = 0; v < n; ++v) {
-        ptv[v] = ptv_of[vis[v] * n + v];
-        pt += pv * ptv[v];
-      }
-      s.p_[i] = pt;
-      if (pt > 0.0) {  // (the test hoisted out of the loop, so that it vectorises)
-        for (std::size_t v = 0; v < n; ++v) row[v] = static_cast<float>(pv * ptv[v] / pt);
+      for (std::size_t v = 0; v < n; ++v) ptv[v] = static_cast<double>(vis[v]) * inv_total[v];
+      double lane[4] = {};  // S(t) in 4 independent sums (a serial sum is latency-bound)
+      std::size_t v = 0;
+      for (; v + 4 <= n; v += 4)
+        for (std::size_t l = 0; l < 4; ++l) lane[l] += ptv[v + l];
+      for (; v < n; ++v) lane[0] += ptv[v];
+      const double sum = (lane[0] + lane[1]) + (lane[2] + lane[3]);
+      s.p_[i] = pv * sum;
+      if (sum > 0.0) {
+        const double inv = 1.0 / sum;
+        for (std::size_t w = 0; w < n; ++w) row[w] = static_cast<float>(ptv[w] * inv);
       } else {
         std::fill(row.begin(), row.end(), 0.0f);
       }
