@@ -279,6 +279,48 @@ static visibility_state sphere_under_roof_state() {
   return std::move(*s);
 }
 
+TEST_CASE("visibility: denoising averages each row with its neighbours within Th", "[cluster][visibility]") {
+  // §3.2.1 written out: the denoised row of t is the mean of the raw rows of t and of its edge
+  // neighbours j (seen, in the set) with raw JS(t, j) <= Th; unseen rows stay 0.
+  indexed_mesh scene = support::make_uv_sphere(16, 10);
+  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
+  test::brute_tracer tracer(scene);
+  auto topo = build_topology(scene);
+  REQUIRE(topo.ok());
+  serial_executor exec;
+  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
+  REQUIRE(p.ok());
+  const auto set = all_triangles(scene.triangles.size());
+  const std::size_t n = p->viewpoints;
+  std::size_t averaged = 0, alone = 0;
+  for (const double th : {0.48, 0.01}) {  // the default, and one under which some rows stay alone
+    p->threshold = th;
+    p->denoise = true;
+    auto denoised = p->init(set);
+    p->denoise = false;
+    auto raw = p->init(set);
+    REQUIRE(denoised.ok());
+    REQUIRE(raw.ok());
+    for (std::uint32_t t = 0; t < set.size(); ++t) {
+      REQUIRE(denoised->input_probability(t) == raw->input_probability(t));
+      std::vector<double> sum(raw->row(t).begin(), raw->row(t).end());
+      std::size_t count = 1;
+      if (!raw->unseen(t))
+        for (std::uint32_t j : topo->neighbours_of(t))
+          if (!raw->unseen(j) && raw->divergence(t, j) <= th) {
+            for (std::size_t v = 0; v < n; ++v) sum[v] += raw->row(j)[v];
+            ++count;
+          }
+      (count > 1 ? averaged : alone) += 1;
+      for (std::size_t v = 0; v < n; ++v)
+        REQUIRE(static_cast<double>(denoised->row(t)[v]) ==
+                Approx(sum[v] / static_cast<double>(count)).epsilon(1e-6).margin(1e-12));
+    }
+  }
+  REQUIRE(averaged > set.size() / 2);  // the scene exercises both cases
+  REQUIRE(alone > 0);
+}
+
 TEST_CASE("visibility: within() gives exactly divergence() <= Th", "[cluster][visibility]") {
   const visibility_state s = sphere_under_roof_state();
   std::size_t checked = 0, below = 0;
