@@ -136,6 +136,9 @@ TEST_CASE("Degener stretch of analytic Jacobians", "[cluster][stretch]") {
   REQUIRE(degener_stretch(c, {0, 0}, {r, r}, {-r, r}, 1.0, 1.0) == Approx(4.0));
   // θ = 0 keeps only the angle term.
   REQUIRE(degener_stretch(c, {0, 0}, {2, 0}, {0, 1}, 1.0, 0.0) == Approx(2.5));
+  // The angle term is scale-free, also where σ² would overflow or underflow a double.
+  REQUIRE(degener_stretch(c, {0, 0}, {2, 0}, {0, 1}, 0x1p600, 0.0) == Approx(2.5));
+  REQUIRE(degener_stretch(c, {0, 0}, {2, 0}, {0, 1}, 0x1p-600, 0.0) == Approx(2.5));
   // Zero-area UV image: the stated special case.
   REQUIRE(std::isinf(degener_stretch(c, {0, 0}, {1, 0}, {2, 0}, 1.0, 1.0)));
   const double raw[] = {5.0, 7.0, std::numeric_limits<double>::infinity(), 6.0};

@@ -65,7 +65,13 @@ inline double degener_stretch(const triangle_corners& c, glm::dvec2 uv0, glm::dv
   const double cc = d1.y * q2y / det_q, d = (d2.y * q1x - d1.y * q2x) / det_q;
   // Closed-form singular values of [a b; cc d].
   const double e = 0.5 * (a + d), f = 0.5 * (a - d), g = 0.5 * (cc + b), h = 0.5 * (cc - b);
-  const double qn = std::hypot(e, h), rn = std::hypot(f, g);
+  // |(u, w)|: sqrt(u² + w²) where the squares can neither overflow nor underflow (libm's
+  // hypot took ~1.5% of the three-channel clustering), hypot elsewhere.
+  auto norm = [](double u, double w) {
+    const double big = std::max(std::abs(u), std::abs(w));
+    return big < 0x1p500 && big > 0x1p-500 ? std::sqrt(u * u + w * w) : std::hypot(u, w);
+  };
+  const double qn = norm(e, h), rn = norm(f, g);
   const double s1 = qn + rn, s2 = std::abs(qn - rn);
   if (!(s2 > 0.0) || !std::isfinite(s1)) return std::numeric_limits<double>::infinity();
   const double area = s1 * s2;
