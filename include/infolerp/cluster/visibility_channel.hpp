@@ -160,16 +160,18 @@ class visibility_state {
   // O(N), no allocation.
   bool surely_within(std::uint32_t a, std::uint32_t b, double threshold) const {
     if (a == b || unseen(a) || unseen(b)) return false;
-    const float* ra = rows_.data() + std::size_t{a} * n_;
-    const float* rb = rows_.data() + std::size_t{b} * n_;
+    return surely_within(rows_.data() + std::size_t{a} * n_, rows_.data() + std::size_t{b} * n_, n_, threshold);
+  }
+  // The same bound for two rows of n entries.
+  static bool surely_within(const float* ra, const float* rb, std::size_t n, double threshold) {
     float l1[8] = {};  // 8 independent sums
     std::size_t v = 0;
-    for (; v + 8 <= n_; v += 8)
+    for (; v + 8 <= n; v += 8)
       for (std::size_t lane = 0; lane < 8; ++lane) l1[lane] += std::abs(ra[v + lane] - rb[v + lane]);
-    for (; v < n_; ++v) l1[0] += std::abs(ra[v] - rb[v]);
+    for (; v < n; ++v) l1[0] += std::abs(ra[v] - rb[v]);
     const double sum = static_cast<double>(((l1[0] + l1[1]) + (l1[2] + l1[3])) + ((l1[4] + l1[5]) + (l1[6] + l1[7])));
     constexpr double h_max = 0.53074;  // > 1/(e·ln 2) = 0.5307378...
-    return h_max * sum * (1.0 + static_cast<double>(n_ + 16) * 0x1p-22) <= threshold - 0x1p-22;
+    return h_max * sum * (1.0 + static_cast<double>(n + 16) * 0x1p-22) <= threshold - 0x1p-22;
   }
   // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
@@ -307,37 +309,47 @@ struct prepared_visibility_channel {
         s.output_[v] = pv;
         inv_total[v] = 1.0 / static_cast<double>(total[v]);
       }
-    std::vector<double> ptv(n);
-    std::vector<float> row(n);
-    s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
+    // 1 / S(t) per row; the rows themselves are written once, denoised or not.
+    std::vector<double> inv_sum(m, 0.0);
     for (std::size_t i = 0; i < m; ++i) {
       const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
-      for (std::size_t v = 0; v < n; ++v) ptv[v] = static_cast<double>(vis[v]) * inv_total[v];
       double lane[4] = {};  // S(t) in 4 independent sums (a serial sum is latency-bound)
       std::size_t v = 0;
       for (; v + 4 <= n; v += 4)
-        for (std::size_t l = 0; l < 4; ++l) lane[l] += ptv[v + l];
-      for (; v < n; ++v) lane[0] += ptv[v];
+        for (std::size_t l = 0; l < 4; ++l) lane[l] += static_cast<double>(vis[v + l]) * inv_total[v + l];
+      for (; v < n; ++v) lane[0] += static_cast<double>(vis[v]) * inv_total[v];
       const double sum = (lane[0] + lane[1]) + (lane[2] + lane[3]);
       s.p_[i] = pv * sum;
-      if (sum > 0.0) {
-        const double inv = 1.0 / sum;
-        for (std::size_t w = 0; w < n; ++w) row[w] = static_cast<float>(ptv[w] * inv);
-      } else {
-        std::fill(row.begin(), row.end(), 0.0f);
-      }
-      s.rows_.insert(s.rows_.end(), row.begin(), row.end());
+      if (sum > 0.0) inv_sum[i] = 1.0 / sum;
     }
-    if (denoise && threshold > 0.0) denoise_rows(triangles, s);
+    // p(v|t) of the set's i-th triangle from its counts, the same bits wherever it is computed
+    // (0 where S(t) = 0).
+    const auto raw_row = [&](std::size_t i, float* out) {
+      const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
+      for (std::size_t v = 0; v < n; ++v) out[v] = static_cast<float>(static_cast<double>(vis[v]) * inv_total[v] * inv_sum[i]);
+    };
+    if (denoise && threshold > 0.0) {
+      denoise_rows(triangles, s, raw_row);
+    } else {
+      std::vector<float> row(n);
+      s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
+      for (std::size_t i = 0; i < m; ++i) {
+        raw_row(i, row.data());
+        s.rows_.insert(s.rows_.end(), row.begin(), row.end());
+      }
+    }
     s.find_representatives();
     s.all_alike_ = std::all_of(s.rep_.begin(), s.rep_.end(), [](std::uint32_t r) { return r == 0; });
     return s;
   }
 
  private:
-  // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th}.
-  // The tests go through visibility_state::within, which its bound mostly decides without JS.
-  void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s) const {
+  // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th},
+  // all rows as raw_row(i, out) writes them from the visible counts (a neighbour costs its N
+  // bytes of counts, not a 4N-byte row kept in an M×N buffer). The tests go through the bound
+  // of visibility_state::surely_within, which mostly decides without JS.
+  template <class RawRow>
+  void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s, const RawRow& raw_row) const {
     const std::size_t m = triangles.size(), n = viewpoints, nt = neighbour_offsets.size() - 1;
     // Local id of a mesh triangle: a table when the set is a large part of the mesh, else a
     // binary search in (global, local) pairs.
@@ -356,47 +368,54 @@ struct prepared_visibility_channel {
       const auto it = std::lower_bound(sorted.begin(), sorted.end(), std::pair{t, 0u});
       return it != sorted.end() && it->first == t ? it->second : invalid_id;
     };
-    std::vector<float, large_buffer_allocator<float>> out;
-    std::vector<float> row(n);
-    out.reserve(m * n);  // appended row by row: no M×N zero fill first
-    std::vector<const float*> src;  // the rows averaged into row i: its own first
+    s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
+    std::vector<float> rows;  // row i, then the accepted neighbours' rows (and one being tested)
+    std::vector<float> out(n);
     for (std::uint32_t i = 0; i < m; ++i) {
-      // The neighbours' rows are far apart in memory: ask for those of a triangle a few
-      // iterations ahead (large sets, whose rows do not stay in cache).
-      if (constexpr std::uint32_t ahead = 4; !table.empty() && i + ahead < m) {
+      const std::uint32_t g = triangles[i];
+#if defined(__GNUC__)
+      // The neighbours' counts are far apart in memory: ask for those of a triangle a few
+      // iterations ahead.
+      if (constexpr std::uint32_t ahead = 4; i + ahead < m) {
         const std::uint32_t h = triangles[i + ahead];
         for (std::uint32_t k = neighbour_offsets[h]; k < neighbour_offsets[h + 1]; ++k)
-          if (const std::uint32_t j = local_of(neighbours[k]); j != invalid_id) s.prefetch(j);
+          for (std::size_t b = 0; b < n; b += 64) __builtin_prefetch(visible.data() + std::size_t{neighbours[k]} * n + b);
       }
+#endif
       if (s.unseen(i)) {  // stays 0
-        out.insert(out.end(), n, 0.0f);
+        s.rows_.insert(s.rows_.end(), n, 0.0f);
         continue;
       }
-      src.assign(1, s.rows_.data() + std::size_t{i} * n);
-      const std::uint32_t g = triangles[i];
+      const std::size_t degree = neighbour_offsets[g + 1] - neighbour_offsets[g];
+      if (rows.size() < (degree + 1) * n) rows.resize((degree + 1) * n);
+      raw_row(i, rows.data());
+      std::size_t count = 1;
       for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
         const std::uint32_t j = local_of(neighbours[k]);
-        if (j != invalid_id && !s.unseen(j) && s.within(i, j, threshold)) src.push_back(s.rows_.data() + std::size_t{j} * n);
+        if (j == invalid_id || s.unseen(j)) continue;
+        float* rj = rows.data() + count * n;
+        raw_row(j, rj);
+        if (visibility_state::surely_within(rows.data(), rj, n, threshold) ||
+            js_channel(std::span<const float>(rows.data(), n), std::span<const float>(rj, n), s.p_[i], s.p_[j]) <= threshold)
+          ++count;
       }
       // The sum in double, rows in order, 8 entries at a time in registers; then / count, by a
       // power of two as a product by its inverse (the same bits, no division).
-      const std::size_t count = src.size();
       const auto c = static_cast<double>(count);
       const bool pow2 = (count & (count - 1)) == 0;
       const double inv = 1.0 / c;
       auto mean = [&](std::size_t v, std::size_t lanes) {
         double a[8];
-        for (std::size_t l = 0; l < lanes; ++l) a[l] = src[0][v + l];
+        for (std::size_t l = 0; l < lanes; ++l) a[l] = rows[v + l];
         for (std::size_t k = 1; k < count; ++k)
-          for (std::size_t l = 0; l < lanes; ++l) a[l] += src[k][v + l];
-        for (std::size_t l = 0; l < lanes; ++l) row[v + l] = static_cast<float>(pow2 ? a[l] * inv : a[l] / c);
+          for (std::size_t l = 0; l < lanes; ++l) a[l] += rows[k * n + v + l];
+        for (std::size_t l = 0; l < lanes; ++l) out[v + l] = static_cast<float>(pow2 ? a[l] * inv : a[l] / c);
       };
       std::size_t v = 0;
       for (; v + 8 <= n; v += 8) mean(v, 8);
       if (v < n) mean(v, n - v);
-      out.insert(out.end(), row.begin(), row.end());
+      s.rows_.insert(s.rows_.end(), out.begin(), out.end());
     }
-    s.rows_ = std::move(out);
   }
 };
 
