@@ -13,6 +13,25 @@
 //                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
+// Measured 2026-12-02, stop 15 (CPU time, one core of a 2-core AMD EPYC VM (Zen 4) with
+// AVX-512, the noisiest yet: the same binary 171-280 ms from run to run; min and median over
+// 72 alternating runs of 6 repetitions):
+//   BM_Clustering_RefinedElephant   min 174.2 / median 205.3 ms against 179.1 / 208.6 for the
+//     previous version (1c2357f), same clusters (cluster_of_fnv24 7619422). Goal <= 150 ms NOT
+//     met here (-march=native builds: min 168 / median 179 in 18 runs). Peak RSS 85 MB (107
+//     before). The steps (perf share of the whole process, each against the one before; the
+//     clusters bit-identical after each): visibility init's own loops vectorised (p(t|v) from
+//     integer count sums, p(v|t) = p(t|v)/S(t): 4.6% -> 2.1%), denoising summed in registers
+//     (6.1% -> 5.1%), libm's hypot replaced where squares are safe in the stretch channel
+//     (1.5% -> 0.2%), denoising from the visible counts so the raw M×N row buffer is gone
+//     (time neutral, 22 MB less memory). Tried and not kept: the split flood reading 2-byte
+//     filter bits per slot instead of the 8-byte edge keys (10.4% -> 10.2%, noise), the subset
+//     graph written by index instead of push_back (no change). The three-channel run's biggest
+//     parts now: visibility smoothing 12%, the JS estimates 10%, denoising 8%, visibility
+//     growth 5% of all samples (the process includes the untimed rays, ~22%).
+//   BM_VisibilityChannel_Total 1890 ms, BM_VisibilityChannel_RaysOnly 1803 ms wall (1864 CPU)
+//     in one run: 1.05x (goal <= 1.3x; the previous version 1872 / 1776 in the same session).
+//     Counted/0 322 ms, Counted/1 260 ms in one noisy run, exact JS counts unchanged.
 // Measured 2026-12-02, later (CPU time, one core of another 2-core AMD EPYC VM, with AVX-512,
 // ~25% steal time: single runs vary by +-15%, so min and median over alternating runs):
 //   BM_Clustering_RefinedElephant   min 148.2 / median 155.7 ms over 36 runs against 171.1 /

@@ -268,16 +268,27 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
 
 // A UV sphere under a roof, 32 viewpoints: rows from alike to disjoint, symmetric rows, and
 // unseen triangles under the cap; the state of the visibility channel on all of it.
-static visibility_state sphere_under_roof_state() {
-  indexed_mesh scene = support::make_uv_sphere(16, 10);
-  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
-  test::brute_tracer tracer(scene);
-  auto topo = build_topology(scene);
+struct sphere_under_roof {
+  indexed_mesh scene;
+  mesh_topology topo;
+  prepared_visibility_channel channel;
+};
+static sphere_under_roof make_sphere_under_roof() {
+  sphere_under_roof r{support::make_uv_sphere(16, 10), {}, {}};
+  support::append(r.scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
+  test::brute_tracer tracer(r.scene);
+  auto topo = build_topology(r.scene);
   REQUIRE(topo.ok());
+  r.topo = std::move(*topo);
   serial_executor exec;
-  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
+  auto p = visibility_channel{.viewpoints = 32}.prepare(r.scene, r.topo, tracer, exec);
   REQUIRE(p.ok());
-  auto s = p->init(all_triangles(scene.triangles.size()));
+  r.channel = std::move(*p);
+  return r;
+}
+static visibility_state sphere_under_roof_state() {
+  const sphere_under_roof r = make_sphere_under_roof();
+  auto s = r.channel.init(all_triangles(r.scene.triangles.size()));
   REQUIRE(s.ok());
   return std::move(*s);
 }
@@ -285,15 +296,10 @@ static visibility_state sphere_under_roof_state() {
 TEST_CASE("visibility: denoising averages each row with its neighbours within Th", "[cluster][visibility]") {
   // §3.2.1 written out: the denoised row of t is the mean of the raw rows of t and of its edge
   // neighbours j (seen, in the set) with raw JS(t, j) <= Th; unseen rows stay 0.
-  indexed_mesh scene = support::make_uv_sphere(16, 10);
-  support::append(scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
-  test::brute_tracer tracer(scene);
-  auto topo = build_topology(scene);
-  REQUIRE(topo.ok());
-  serial_executor exec;
-  auto p = visibility_channel{.viewpoints = 32}.prepare(scene, *topo, tracer, exec);
-  REQUIRE(p.ok());
-  const auto set = all_triangles(scene.triangles.size());
+  sphere_under_roof r = make_sphere_under_roof();
+  prepared_visibility_channel* p = &r.channel;
+  const mesh_topology* topo = &r.topo;
+  const auto set = all_triangles(r.scene.triangles.size());
   const std::size_t n = p->viewpoints;
   std::size_t averaged = 0, alone = 0;
   for (const double th : {0.48, 0.01}) {  // the default, and one under which some rows stay alone
