@@ -55,6 +55,18 @@
 
 namespace infolerp {
 
+namespace detail {
+// Asks for the cache lines of [p, p + bytes): a hint without effect on results (the rows and
+// counts the channel reads next are far apart in memory).
+inline void prefetch_bytes(const void* p, std::size_t bytes) {
+#if defined(__GNUC__)
+  for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(static_cast<const char*>(p) + b);
+#else
+  (void)p, (void)bytes;
+#endif
+}
+}  // namespace detail
+
 // n points on a sphere by the Fibonacci lattice (near-uniform, deterministic). O(n).
 inline std::vector<glm::dvec3> fibonacci_sphere(std::size_t n, glm::dvec3 center, double radius) {
   std::vector<glm::dvec3> out(n);
@@ -175,18 +187,16 @@ class visibility_state {
   }
   // divergence(a, b) <= threshold, by the bound where it decides.
   bool within(std::uint32_t a, std::uint32_t b, double threshold) const {
-    return surely_within(a, b, threshold) || divergence(a, b) <= threshold;
+    if (a == b || unseen(a) || unseen(b)) return divergence(a, b) <= threshold;
+    return within(row(a), row(b), p_[a], p_[b], threshold);
+  }
+  // The same for two seen rows with input probabilities pa, pb (denoising's raw rows).
+  static bool within(std::span<const float> ra, std::span<const float> rb, double pa, double pb, double threshold) {
+    return surely_within(ra.data(), rb.data(), ra.size(), threshold) || js_channel(ra, rb, pa, pb) <= threshold;
   }
   // Asks for t's row in cache, a hint without effect on results: region growing calls it a
   // few classes ahead (the rows a seed search reads are far apart and each is read once).
-  void prefetch(std::uint32_t t) const {
-#if defined(__GNUC__)
-    const char* r = reinterpret_cast<const char*>(rows_.data() + std::size_t{t} * n_);
-    for (std::size_t b = 0; b < n_ * sizeof(float); b += 64) __builtin_prefetch(r + b);
-#else
-    (void)t;
-#endif
-  }
+  void prefetch(std::uint32_t t) const { detail::prefetch_bytes(rows_.data() + std::size_t{t} * n_, n_ * sizeof(float)); }
   double mutual_information(std::uint32_t t) const {
     if (unseen(t)) return std::numeric_limits<double>::infinity();
     return element_mutual_information(row(t), output_);
@@ -235,9 +245,7 @@ class visibility_state {
     }
     const std::size_t bytes = n_ * sizeof(float);
     for (std::uint32_t t = 0; t < m; ++t) {
-#if defined(__GNUC__)
-      if (t + 8 < m) __builtin_prefetch(table.data() + home[t + 8]);  // random slots: ask ahead
-#endif
+      if (t + 8 < m) detail::prefetch_bytes(table.data() + home[t + 8], 1);  // random slots: ask ahead
       const float* r = rows_.data() + std::size_t{t} * n_;
       for (std::size_t slot = home[t];; slot = (slot + 1) & (size - 1)) {
         const std::uint32_t o = table[slot];
@@ -322,19 +330,13 @@ struct prepared_visibility_channel {
       s.p_[i] = pv * sum;
       if (sum > 0.0) inv_sum[i] = 1.0 / sum;
     }
-    // p(v|t) of the set's i-th triangle from its counts, the same bits wherever it is computed
-    // (0 where S(t) = 0).
-    const auto raw_row = [&](std::size_t i, float* out) {
-      const std::uint8_t* vis = visible.data() + std::size_t{triangles[i]} * n;
-      for (std::size_t v = 0; v < n; ++v) out[v] = static_cast<float>(static_cast<double>(vis[v]) * inv_total[v] * inv_sum[i]);
-    };
     if (denoise && threshold > 0.0) {
-      denoise_rows(triangles, s, raw_row);
+      denoise_rows(triangles, inv_total, inv_sum, s);
     } else {
       std::vector<float> row(n);
       s.rows_.reserve(m * n);  // appended row by row: no M×N zero fill first
       for (std::size_t i = 0; i < m; ++i) {
-        raw_row(i, row.data());
+        raw_row(triangles[i], inv_total, inv_sum[i], row.data());
         s.rows_.insert(s.rows_.end(), row.begin(), row.end());
       }
     }
@@ -344,12 +346,19 @@ struct prepared_visibility_channel {
   }
 
  private:
+  // p(v|t) of mesh triangle t from its counts, with inv_sum = 1 / S(t) (0 where S(t) = 0): the
+  // same bits wherever it is computed. O(N), no allocation.
+  void raw_row(std::uint32_t t, std::span<const double> inv_total, double inv_sum, float* out) const {
+    const std::uint8_t* vis = visible.data() + std::size_t{t} * viewpoints;
+    for (std::size_t v = 0; v < viewpoints; ++v) out[v] = static_cast<float>(static_cast<double>(vis[v]) * inv_total[v] * inv_sum);
+  }
+
   // §3.2.1: p(Y|t) <- mean of p(Y|t') over t' in {t} ∪ {edge neighbours in the set, JS <= Th},
-  // all rows as raw_row(i, out) writes them from the visible counts (a neighbour costs its N
-  // bytes of counts, not a 4N-byte row kept in an M×N buffer). The tests go through the bound
-  // of visibility_state::surely_within, which mostly decides without JS.
-  template <class RawRow>
-  void denoise_rows(std::span<const std::uint32_t> triangles, visibility_state& s, const RawRow& raw_row) const {
+  // all rows as raw_row writes them from the visible counts (a neighbour costs its N bytes of
+  // counts, not a 4N-byte row kept in an M×N buffer). The tests go through
+  // visibility_state::within, whose bound mostly decides without JS.
+  void denoise_rows(std::span<const std::uint32_t> triangles, std::span<const double> inv_total,
+                    std::span<const double> inv_sum, visibility_state& s) const {
     const std::size_t m = triangles.size(), n = viewpoints, nt = neighbour_offsets.size() - 1;
     // Local id of a mesh triangle: a table when the set is a large part of the mesh, else a
     // binary search in (global, local) pairs.
@@ -373,31 +382,27 @@ struct prepared_visibility_channel {
     std::vector<float> out(n);
     for (std::uint32_t i = 0; i < m; ++i) {
       const std::uint32_t g = triangles[i];
-#if defined(__GNUC__)
       // The neighbours' counts are far apart in memory: ask for those of a triangle a few
       // iterations ahead.
       if (constexpr std::uint32_t ahead = 4; i + ahead < m) {
         const std::uint32_t h = triangles[i + ahead];
         for (std::uint32_t k = neighbour_offsets[h]; k < neighbour_offsets[h + 1]; ++k)
-          for (std::size_t b = 0; b < n; b += 64) __builtin_prefetch(visible.data() + std::size_t{neighbours[k]} * n + b);
+          detail::prefetch_bytes(visible.data() + std::size_t{neighbours[k]} * n, n);
       }
-#endif
       if (s.unseen(i)) {  // stays 0
         s.rows_.insert(s.rows_.end(), n, 0.0f);
         continue;
       }
       const std::size_t degree = neighbour_offsets[g + 1] - neighbour_offsets[g];
       if (rows.size() < (degree + 1) * n) rows.resize((degree + 1) * n);
-      raw_row(i, rows.data());
+      raw_row(g, inv_total, inv_sum[i], rows.data());
       std::size_t count = 1;
       for (std::uint32_t k = neighbour_offsets[g]; k < neighbour_offsets[g + 1]; ++k) {
         const std::uint32_t j = local_of(neighbours[k]);
         if (j == invalid_id || s.unseen(j)) continue;
         float* rj = rows.data() + count * n;
-        raw_row(j, rj);
-        if (visibility_state::surely_within(rows.data(), rj, n, threshold) ||
-            js_channel(std::span<const float>(rows.data(), n), std::span<const float>(rj, n), s.p_[i], s.p_[j]) <= threshold)
-          ++count;
+        raw_row(neighbours[k], inv_total, inv_sum[j], rj);
+        if (visibility_state::within({rows.data(), n}, {rj, n}, s.p_[i], s.p_[j], threshold)) ++count;
       }
       // The sum in double, rows in order, 8 entries at a time in registers; then / count, by a
       // power of two as a product by its inverse (the same bits, no division).
