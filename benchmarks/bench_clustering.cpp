@@ -13,6 +13,21 @@
 //                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
+// Measured 2026-12-03, stop 18 (CPU time, one core of a 2-core AMD EPYC VM with AVX2 and no
+// AVX-512, idle, c1760c2; f355b86 only moves code):
+//   BM_Clustering_RefinedElephant   256 / 264 ms median (two runs of 4 repetitions), same
+//     clusters (cluster_of_fnv24 7619422), peak RSS 86 MB. Goal <= 150 ms NOT met here.
+//     Per part (a harness mirroring cluster_mesh's channel loop, best of 6, ms): validation 0.8,
+//     topology 7; visibility init 38 (denoising, representatives), growth 43 (first seed's MI
+//     2.8, seed search 16, rings 22, sequential pass 4.3, merging 1.4), smoothing 51 (per-slot
+//     mesh edges 1.9, pairs and member lists 1.7, boundaries 4, bands 13, band edges 4.7, A* 5.3,
+//     the 81 split floods 24: 539k triangles visited, ~45 ns each, latency-bound); orientation
+//     prepare 1, init 2.4, subset graphs 2.4, growth 14, smoothing 20 (5.4 of it per-set setup);
+//     stretch prepare 6, init 12, subset graphs 4, growth 16.5, smoothing 9.5 over 1960 sets.
+//   With refined_elephant's triangles sorted by the Morton code of their centroids (harness
+//   only; different clusters, 4488), the same run takes 212 against 240 ms: visibility init
+//   38 -> 35, growth 43 -> 35, smoothing 51 -> 43 (splits 24 -> 17). The mesh as shipped has
+//   poor locality; an engine's cache-ordered mesh would be ~12% faster.
 // Measured 2026-12-02, stop 15 (CPU time, one core of a 2-core AMD EPYC VM (Zen 4) with
 // AVX-512, the noisiest yet: the same binary 171-280 ms from run to run; min and median over
 // 72 alternating runs of 6 repetitions):
