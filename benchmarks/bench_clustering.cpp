@@ -221,8 +221,16 @@ void BM_Clustering_RefinedElephant(benchmark::State& state) {
   }
   state.counters["triangles"] = static_cast<double>(e.mesh.triangles.size());
   state.counters["clusters"] = last.cluster_count;
-  for (std::size_t i = 0; i < last.channels.size(); ++i)
-    state.counters["after_ch" + std::to_string(i)] = last.channels[i].clusters_after;
+  for (std::size_t i = 0; i < last.channels.size(); ++i) {
+    const channel_report& c = last.channels[i];
+    const std::string ch = "ch" + std::to_string(i);
+    state.counters["after_" + ch] = c.clusters_after;
+    // Where the last iteration's time went, in ms (visibility's prepare is outside the loop).
+    state.counters[ch + "_prepare_ms"] = 1e3 * c.prepare_seconds;
+    state.counters[ch + "_init_ms"] = 1e3 * c.init_seconds;
+    state.counters[ch + "_growth_ms"] = 1e3 * c.growth_seconds;
+    state.counters[ch + "_smoothing_ms"] = 1e3 * c.smoothing_seconds;
+  }
   state.counters["peak_rss_MB"] = peak_rss_mb();
   state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
 }

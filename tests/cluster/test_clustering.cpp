@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -320,11 +321,25 @@ TEST_CASE("real meshes through Embree: three channels, coverage, connectivity, d
       return cluster_mesh(*m, scene, exec, visibility_channel{.threshold = 0.48, .viewpoints = 16, .samples_per_side = 1},
                           orientation_channel{.threshold = 0.05, .bins = 256}, stretch_channel{});
     };
+    const auto start = std::chrono::steady_clock::now();
     auto r = run(support::thread_pool_executor{2});
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     REQUIRE(r.ok());
     check_invariants(*m, *r);
     REQUIRE(r->channels[0].skipped == nullptr);
     REQUIRE(r->channels[2].skipped != nullptr);  // no texcoords
+    // Stage times: every stage of a channel that ran took time, a skipped channel's sets took
+    // none, and all of them fit in the call's wall time.
+    double staged = 0;
+    for (const channel_report& c : r->channels) {
+      staged += c.prepare_seconds + c.init_seconds + c.growth_seconds + c.smoothing_seconds;
+      const bool ran = c.skipped == nullptr;
+      CHECK(c.prepare_seconds > 0);
+      CHECK((c.init_seconds > 0) == ran);
+      CHECK((c.growth_seconds > 0) == ran);
+      CHECK((c.smoothing_seconds > 0) == ran);
+    }
+    CHECK(staged <= wall);
     REQUIRE(r->channels[0].clusters_after > 1);
     REQUIRE(r->cluster_count >= r->channels[0].clusters_after);
     REQUIRE(r->cluster_count < m->triangles.size() / 4);

@@ -13,6 +13,7 @@
 // Output: a dense cluster id per triangle (0..C−1, numbered by smallest triangle), every
 // cluster edge-connected, identical for any executor and thread count. Th = 0 for any channel
 // gives one cluster per triangle, Th = 1 for every channel one cluster per connected component.
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -51,6 +52,10 @@ struct channel_report {
   std::uint32_t merged = 0;            // clusters merged away (§3.2.4)
   std::uint32_t all_alike_sets = 0;    // sets whose rows were all alike (no work done)
   std::uint32_t smoothed_triangles = 0;  // triangles moved by boundary smoothing
+  // Wall time of each stage over all sets, in seconds (steady clock), so an engine can see
+  // what a channel costs: prepare (whole mesh; 0 for a channel passed prepared), init (rows
+  // per set), growth (dual graph, seeds, growth, merging), smoothing.
+  double prepare_seconds = 0, init_seconds = 0, growth_seconds = 0, smoothing_seconds = 0;
 };
 
 struct mesh_clustering {
@@ -68,6 +73,12 @@ concept clustering_channel =
     };
 
 namespace detail {
+
+// Seconds on the steady clock since `since`, which is then moved to now.
+inline double lap(std::chrono::steady_clock::time_point& since) {
+  const auto now = std::chrono::steady_clock::now();
+  return std::chrono::duration<double>(now - std::exchange(since, now)).count();
+}
 
 // Runs one prepared channel over every current cluster (Algorithm 1's inner loop).
 template <class P, class M, class E>
@@ -94,12 +105,16 @@ status run_channel(const P& ch, const M& m, const mesh_topology& topo, const clu
   const region_growing_options go{static_cast<double>(ch.threshold), o.min_cluster_fraction, o.grain};
   for (std::uint32_t k = 0; k < count; ++k) {
     const std::span<const std::uint32_t> set(tris.data() + offsets[k], offsets[k + 1] - offsets[k]);
+    auto clock = std::chrono::steady_clock::now();
     auto state = ch.init(set);
     if (!state) return state.error();
+    rep.init_seconds += lap(clock);
     const element_graph g = subset_graph(topo, set, scratch);
     auto r = grow_regions(*state, g, go, exec);
     if (!r) return r.error();
+    rep.growth_seconds += lap(clock);
     if (o.smooth_boundaries) rep.smoothed_triangles += smooth_boundaries(*state, g, m, set, go.threshold, *r);
+    rep.smoothing_seconds += lap(clock);
     for (std::size_t i = 0; i < set.size(); ++i) next[set[i]] = next_count + r->cluster_of[i];
     next_count += r->cluster_count();
     rep.seeds += r->parallel_seeds;
@@ -117,8 +132,10 @@ template <class C, class M, class T, class E>
 status apply_channel(const C& c, const M& m, const mesh_topology& topo, const T& tracer, const cluster_options& o,
                      E& exec, std::vector<std::uint32_t>& label, std::uint32_t& count, channel_report& rep) {
   if constexpr (requires { c.prepare(m, topo, tracer, exec); }) {
+    auto clock = std::chrono::steady_clock::now();
     auto p = c.prepare(m, topo, tracer, exec);
     if (!p) return p.error();
+    rep.prepare_seconds = lap(clock);
     return run_channel(*p, m, topo, o, exec, label, count, rep);
   } else {
     return run_channel(c, m, topo, o, exec, label, count, rep);
