@@ -1,6 +1,8 @@
 // Clustering (issue 3) on CGAL's refined_elephant (~89k triangles) and procedural meshes.
 //   BM_Clustering_RefinedElephant   Algorithm 1: visibility → orientation → stretch, one core,
 //                                   visibility rays precomputed outside the timed loop. Goal ≤ 150 ms.
+//                                   Counters chN_{prepare,init,growth,smoothing}_ms: channel N's
+//                                   stages in the last iteration (channel_report's stage times).
 //   BM_OrientationChannel/K/rows (CGAL's fandisk), BM_OrientationChannel_Torus/K/rows,
 //   BM_StretchChannel/K/rows (UV sphere)   one-channel clustering, K = 0 (exact) or bins, rows 0
 //                                   per cell or 1 exact rows over the cells: time, JS abs error
@@ -13,6 +15,26 @@
 //                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
+// Measured 2026-12-03, stop 19 (the same AVX2-only EPYC VM as stop 18, noisy: one binary ran
+// 240-345 ms in a harness within minutes, so alternating runs and in-process A/B comparisons):
+//   BM_Clustering_RefinedElephant   268 / 297 ms median (two runs of 4 repetitions), same
+//     clusters (cluster_of_fnv24 7619422), peak RSS 86 MB. Goal <= 150 ms NOT met. Stage
+//     medians from the new counters (the 268 ms run): visibility init 42, growth 50, smoothing
+//     59; orientation prepare 1.1, init 2.8, growth 18, smoothing 22; stretch prepare 6.7, init
+//     14, growth 23, smoothing 10. Tried and not kept (clusters identical in each):
+//     - the split decided from pieces: flood only the parts left by cutting A and B along the
+//       old and the new boundary (capped floods, one capped "bulk" per side, union-find over the
+//       pieces); the split part of visibility smoothing 23.7 -> 19.8 ms, orientation's 3.6 ->
+//       4.4, whole smoothing unchanged within noise. The pieces between the two boundaries hold
+//       200k of the 539k triangles the full floods visit: most of the work is inherent.
+//     - a byte per slot marking the path's crossings for the flood (the idea of stop 14 again):
+//       visibility smoothing -2 to -4 ms, orientation +1 to +2.5 ms in an in-process A/B.
+//     - byte-sized flood marks instead of 4-byte region ids: no difference measurable.
+//     - each set ordered by its triangles' Morton codes inside the channel loop (the mesh left
+//       as is): 248 against 236 ms; smoothing -9, but init reads the counts out of order (+7)
+//       and ordering costs 11 ms. Reordering the whole mesh (triangles by Morton code, vertices
+//       by first use) gives 216-219 against 240 ms: ~10%, for engines that feed ordered meshes.
+//     - -march=native: no gain on this machine (min 253 against 246 ms).
 // Measured 2026-12-03, stop 18 (CPU time, one core of a 2-core AMD EPYC VM with AVX2 and no
 // AVX-512, idle, c1760c2; f355b86 only moves code):
 //   BM_Clustering_RefinedElephant   256 / 264 ms median (two runs of 4 repetitions), same
