@@ -10,6 +10,8 @@
 //                                   ARI >= 0.99 at >= 10x less time.
 //   BM_VisibilityChannel_Total / BM_VisibilityChannel_RaysOnly   the channel against the raw time
 //                                   of its own rays through the same tracer. Goal ≤ 1.3×.
+//   BM_Clustering_RefinedElephant_Ordered   the same on the mesh reordered for locality
+//                                   (triangles by Morton code, vertices by first use).
 //   BM_Clustering_RefinedElephant_Counted/E   the same through support::counting_channel, with
 //                                   the JS estimate (E = 1) or without (E = 0: the baseline, exact
 //                                   JS for every comparison), counting exact JS per channel.
@@ -33,7 +35,9 @@
 //     - each set ordered by its triangles' Morton codes inside the channel loop (the mesh left
 //       as is): 248 against 236 ms; smoothing -9, but init reads the counts out of order (+7)
 //       and ordering costs 11 ms. Reordering the whole mesh (triangles by Morton code, vertices
-//       by first use) gives 216-219 against 240 ms: ~10%, for engines that feed ordered meshes.
+//       by first use) gives 216-219 against 240 ms in the harness; in this benchmark
+//       BM_Clustering_RefinedElephant_Ordered took 252 against 301 ms median (one run of 4
+//       repetitions, both in it; 37 / 2100 / 4586 clusters against 34 / 1960 / 4248).
 //     - -march=native: no gain on this machine (min 253 against 246 ms).
 // Measured 2026-12-03, stop 18 (CPU time, one core of a 2-core AMD EPYC VM with AVX2 and no
 // AVX-512, idle, c1760c2; f355b86 only moves code):
@@ -140,6 +144,7 @@
 #include <type_traits>
 #include <vector>
 #include "infolerp/cluster/cluster_mesh.hpp"
+#include "infolerp/mesh/locality_order.hpp"
 #include "support/counting_channel.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
@@ -178,22 +183,53 @@ struct elephant_scene {
 
 const visibility_channel elephant_visibility{.threshold = 0.48, .viewpoints = 64, .samples_per_side = 2};
 
+// The mesh with its triangles in Morton order (mesh/locality_order.hpp) and its vertices
+// renumbered by first use: what an engine's locality-ordered copy would look like.
+void reorder_for_locality(indexed_mesh& m) {
+  const std::vector<std::uint32_t> order = morton_triangle_order(m);
+  std::vector<glm::uvec3> tris(order.size());
+  std::vector<std::uint32_t> vertex(m.positions.size(), invalid_id);
+  std::vector<glm::vec3> pos;
+  pos.reserve(m.positions.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    glm::uvec3 t = m.triangles[order[i]];
+    for (int k = 0; k < 3; ++k) {
+      if (vertex[t[k]] == invalid_id) {
+        vertex[t[k]] = static_cast<std::uint32_t>(pos.size());
+        pos.push_back(m.positions[t[k]]);
+      }
+      t[k] = vertex[t[k]];
+    }
+    tris[i] = t;
+  }
+  m.triangles = std::move(tris);
+  m.positions = std::move(pos);
+}
+
+elephant_scene make_elephant(bool ordered) {
+  elephant_scene e;
+  auto m = support::load_mesh(support::cgal_mesh("refined_elephant"));
+  if (!m) return e;
+  e.mesh = std::move(*m);
+  if (ordered) reorder_for_locality(e.mesh);
+  add_spherical_texcoords(e.mesh);
+  e.topo = std::move(*build_topology(e.mesh));
+  e.device = std::make_unique<support::embree_device>("threads=1");
+  e.tracer = std::make_unique<support::embree_scene>(*e.device);
+  if (!e.tracer->add_mesh(e.mesh) || !e.tracer->commit()) return e;
+  serial_executor exec;
+  e.visibility = std::move(*elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec));
+  e.ok = true;
+  return e;
+}
+
 elephant_scene& elephant() {
-  static elephant_scene s = [] {
-    elephant_scene e;
-    auto m = support::load_mesh(support::cgal_mesh("refined_elephant"));
-    if (!m) return e;
-    e.mesh = std::move(*m);
-    add_spherical_texcoords(e.mesh);
-    e.topo = std::move(*build_topology(e.mesh));
-    e.device = std::make_unique<support::embree_device>("threads=1");
-    e.tracer = std::make_unique<support::embree_scene>(*e.device);
-    if (!e.tracer->add_mesh(e.mesh) || !e.tracer->commit()) return e;
-    serial_executor exec;
-    e.visibility = std::move(*elephant_visibility.prepare(e.mesh, e.topo, *e.tracer, exec));
-    e.ok = true;
-    return e;
-  }();
+  static elephant_scene s = make_elephant(false);
+  return s;
+}
+
+elephant_scene& elephant_ordered() {
+  static elephant_scene s = make_elephant(true);
   return s;
 }
 
@@ -229,8 +265,7 @@ double fnv24(const std::vector<std::uint32_t>& labels) {
   return static_cast<double>(h >> 8);
 }
 
-void BM_Clustering_RefinedElephant(benchmark::State& state) {
-  auto& e = elephant();
+void run_elephant(benchmark::State& state, elephant_scene& e) {
   if (!e.ok) return state.SkipWithError("refined_elephant not found");
   serial_executor exec;
   mesh_clustering last;
@@ -256,7 +291,14 @@ void BM_Clustering_RefinedElephant(benchmark::State& state) {
   state.counters["peak_rss_MB"] = peak_rss_mb();
   state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
 }
+
+void BM_Clustering_RefinedElephant(benchmark::State& state) { run_elephant(state, elephant()); }
 BENCHMARK(BM_Clustering_RefinedElephant)->Unit(benchmark::kMillisecond);
+
+// The same mesh in locality order (reorder_for_locality): what mesh order costs. Different
+// clusters (ties fall differently), the same channels and thresholds.
+void BM_Clustering_RefinedElephant_Ordered(benchmark::State& state) { run_elephant(state, elephant_ordered()); }
+BENCHMARK(BM_Clustering_RefinedElephant_Ordered)->Unit(benchmark::kMillisecond);
 
 // The same clustering through support::counting_channel: with the JS estimate (1) or without it
 // (0, the exact kernel for every comparison, the baseline), counting the exact divergences per

@@ -1,8 +1,13 @@
-// mesh/topology.hpp against brute-force references on procedural and real meshes.
+// mesh/topology.hpp against brute-force references on procedural and real meshes, and
+// mesh/locality_order.hpp.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstdlib>
+#include <numeric>
+#include <random>
 #include <set>
+#include "infolerp/mesh/locality_order.hpp"
 #include "infolerp/mesh/topology.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
@@ -127,4 +132,35 @@ TEST_CASE("real meshes from CGAL data: edge and face lists agree") {
   auto missing = infolerp::support::load_mesh("/nonexistent/mesh.off");
   REQUIRE_FALSE(missing.ok());
   CHECK(missing.error().message().find("/nonexistent/mesh.off") != std::string::npos);
+}
+
+TEST_CASE("Morton order is a permutation that brings dual-graph neighbours close, and is idempotent") {
+  auto m = infolerp::support::make_torus(64, 32, 1.0f, 0.4f);
+  std::mt19937 rng(7);
+  std::shuffle(m.triangles.begin(), m.triangles.end(), rng);  // a mesh file in no spatial order
+  // Mean |index distance| between dual-graph neighbours.
+  auto spread = [](const infolerp::indexed_mesh& mesh) {
+    auto topo = infolerp::build_topology(mesh);
+    REQUIRE(topo.ok());
+    double sum = 0.0, pairs = 0.0;
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+      for (std::uint32_t n : topo->neighbours_of(t)) {
+        sum += std::abs(static_cast<double>(n) - static_cast<double>(t));
+        pairs += 1.0;
+      }
+    return sum / pairs;
+  };
+  const std::vector<std::uint32_t> order = infolerp::morton_triangle_order(m);
+  REQUIRE(order.size() == m.triangles.size());
+  std::vector<std::uint32_t> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<std::uint32_t> identity(order.size());
+  std::iota(identity.begin(), identity.end(), 0u);
+  REQUIRE(sorted == identity);
+  infolerp::indexed_mesh ordered = m;
+  for (std::size_t i = 0; i < order.size(); ++i) ordered.triangles[i] = m.triangles[order[i]];
+  const double before = spread(m), after = spread(ordered);
+  INFO("mean neighbour index distance " << before << " -> " << after);
+  CHECK(after * 10.0 < before);
+  CHECK(infolerp::morton_triangle_order(ordered) == identity);
 }

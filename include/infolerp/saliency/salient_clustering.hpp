@@ -37,6 +37,7 @@
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/mesh/locality_order.hpp"
 #include "infolerp/mesh/topology.hpp"
 
 namespace infolerp {
@@ -83,23 +84,11 @@ template <class M>
 face_data make_face_data(const M& m, const mesh_topology& topo, std::span<const double> saliency) {
   const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
   std::vector<glm::dvec3> centroid(nt);
-  bounding_box box;
-  for (std::size_t t = 0; t < nt; ++t) centroid[t] = triangle_centroid(corners(m, t)), box.extend(centroid[t]);
-  const glm::dvec3 ext = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> key(nt);
-  for (std::size_t t = 0; t < nt; ++t) {
-    std::uint64_t code = 0;
-    for (int a = 0; a < 3; ++a) {
-      const auto q = static_cast<std::uint64_t>(std::clamp((centroid[t][a] - box.lo[a]) / ext[a], 0.0, 1.0) * 2097151.0);
-      for (int bit = 0; bit < 21; ++bit) code |= (q >> bit & 1u) << (3 * bit + a);
-    }
-    key[t] = {code, static_cast<std::uint32_t>(t)};
-  }
-  std::sort(key.begin(), key.end());
+  for (std::size_t t = 0; t < nt; ++t) centroid[t] = triangle_centroid(corners(m, t));
   face_data fd;
-  fd.original.resize(nt);
+  fd.original = morton_triangle_order(m);
   std::vector<std::uint32_t> internal(nt);
-  for (std::size_t i = 0; i < nt; ++i) fd.original[i] = key[i].second, internal[key[i].second] = static_cast<std::uint32_t>(i);
+  for (std::size_t i = 0; i < nt; ++i) internal[fd.original[i]] = static_cast<std::uint32_t>(i);
   fd.hot.resize(nt), fd.area.resize(nt), fd.on_boundary.assign(nt, 0);
   fd.nb_offsets.assign(nt + 1, 0);
   fd.nb.reserve(topo.neighbours.size()), fd.step_length.reserve(topo.neighbours.size());
