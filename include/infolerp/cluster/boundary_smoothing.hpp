@@ -77,16 +77,14 @@ inline void sort_keys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_
 
 // Smooths the boundaries of clustering `r` of the set `triangles` (local ids = positions) of
 // mesh m, whose channel state is s and dual graph g. Returns the number of triangles moved.
-// Preconditions: r from grow_regions(s, g, ...), g the dual graph of `triangles` (subset_graph;
-// the split relies on all triangles around a mesh edge being neighbours). Complexity per
+// Preconditions: r from grow_regions(s, g, ...), g symmetric (a dual graph is). Complexity per
 // neighbouring pair: O(min(|A|, |B|)) to find the boundary, O(band · log band) for the band and
 // the path, and O(|A| + |B|) only when a new path is tried (the split). Divergences only for
 // the boundary and band triangles, each JS(class, seed) once per set when clusters × classes
 // <= 2^20 (else once per pair), once per representative when the state has representative();
 // with the state's estimate(), estimates there, and divergences only where the two estimates'
 // error intervals overlap (the same comparisons as with exact values).
-// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call, and a
-// byte per slot for the path's cut), plus
+// Allocation O(M·degree) (the mesh edge of each dual-graph slot is found once per call), plus
 // 12·clusters·classes bytes for the memo when it is kept per set (else 24·classes); the
 // per-pair buffers are reused from pair to pair.
 template <class S, class M>
@@ -134,8 +132,6 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
   // A 2^16-bit filter of the path's edge keys, so the split's flood fill rarely needs the
   // binary search in `path` (all 0 between pairs; allocated at the first split tried).
   std::vector<std::uint64_t> path_filter;
-  std::vector<std::uint8_t> cut(g.neighbours.size(), 0);  // all 0 between pairs
-  std::vector<std::uint32_t> cut_slots;
   auto filter_bit = [](std::uint64_t key) { return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 48); };
   // JS(class, seed of a cluster), memoised per (cluster, class) over all pairs when
   // clusters × classes <= 2^20 (binned direct channels), else per (side of the pair, class)
@@ -354,22 +350,6 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     auto on_path = [&](std::uint64_t e) {
       return (path_filter[filter_bit(e) >> 6] >> (filter_bit(e) & 63) & 1) && std::binary_search(path.begin(), path.end(), e);
     };
-    // The slots that cross the path, marked in `cut` (1 byte per slot, so the flood below reads
-    // neither the 8-byte edge keys nor the filter). A triangle with such a slot holds a path
-    // edge, so it lies on the old boundary (in `frontier`), is a band triangle, or is a band
-    // triangle's neighbour (all triangles around an edge are neighbours in a dual graph).
-    auto mark_cut = [&](std::uint32_t t) {
-      for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot)
-        if (!cut[slot] && slot_edge[slot] != no_edge && on_path(slot_edge[slot])) {
-          cut[slot] = 1;
-          cut_slots.push_back(slot);
-        }
-    };
-    for (std::uint32_t t : frontier) mark_cut(t);
-    for (std::uint32_t t : band) {
-      mark_cut(t);
-      for (std::uint32_t j : g.neighbours_of(t)) mark_cut(j);
-    }
 
     // 4. Split A ∪ B along the path.
     members.resize(members_of[ca].size() + members_of[cb].size());
@@ -394,7 +374,8 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
         stack.pop_back();
         for (std::uint32_t slot = g.offsets[t]; slot < g.offsets[t + 1]; ++slot) {
           const std::uint32_t j = g.neighbours[slot];
-          if (region[j] != unvisited || cut[slot]) continue;
+          if (region[j] != unvisited) continue;
+          if (slot_edge[slot] != no_edge && on_path(slot_edge[slot])) continue;
           region[j] = regions;
           stack.push_back(j);
         }
@@ -420,8 +401,6 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
     }
     for (std::uint32_t i : members) region[i] = invalid_id;
     for (auto e : path) path_filter[filter_bit(e) >> 6] = 0;
-    for (std::uint32_t slot : cut_slots) cut[slot] = 0;
-    cut_slots.clear();
   }
   return moved;
 }
