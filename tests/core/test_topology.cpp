@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
-#include <cstdlib>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <set>

@@ -86,7 +86,7 @@ face_data make_face_data(const M& m, const mesh_topology& topo, std::span<const 
   std::vector<glm::dvec3> centroid(nt);
   for (std::size_t t = 0; t < nt; ++t) centroid[t] = triangle_centroid(corners(m, t));
   face_data fd;
-  fd.original = morton_triangle_order(m);
+  fd.original = morton_order(centroid);
   std::vector<std::uint32_t> internal(nt);
   for (std::size_t i = 0; i < nt; ++i) internal[fd.original[i]] = static_cast<std::uint32_t>(i);
   fd.hot.resize(nt), fd.area.resize(nt), fd.on_boundary.assign(nt, 0);
