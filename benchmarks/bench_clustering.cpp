@@ -17,6 +17,20 @@
 //                                   JS for every comparison), counting exact JS per channel.
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 //
+// Measured 2026-12-03, stop 20 (the same AVX2-only EPYC VM, slower this day: the same code ran
+// 340-470 ms in a loop of 20 calls; the benchmark now also reports the min of repetitions):
+//   BM_Clustering_RefinedElephant   median 416 / 423 / 413 ms, min 364 / 419 / 398 (three runs
+//     of 5 repetitions), clusters unchanged (cluster_of_fnv24 7619422). _Ordered in the same
+//     runs: median 343 / 322 / 352, min 314 / 285 / 343. Goal <= 150 ms NOT met. Tried, not kept:
+//     - the split as one breadth-first flood from all triangles on the path's edges, each its
+//       own part, parts joined by union-find where floods meet, stopped once one part is closed
+//       and the other sources are joined (A ∪ B is connected, so every part holds such a
+//       triangle): identical results, visits 539k -> 356k (visibility) and 103k -> 60k
+//       (orientation), but smoothing slower in an in-process A/B of 21 alternating
+//       repetitions: visibility min 109.8 against 100.6 ms, orientation 25.8 against 22.1.
+//     - fewer viewpoints as a shortcut: N = 32 ran min 256 against 378 ms for N = 64 (N = 16:
+//       274), but its visibility clusters agree with N = 64's at ARI 0.32 (0.21 for N = 16;
+//       0.50 / 0.41 after all three channels): not an approximation of the same clustering.
 // Measured 2026-12-03, stop 19 (the same AVX2-only EPYC VM as stop 18, noisy: one binary ran
 // 240-345 ms in a harness within minutes, so alternating runs and in-process A/B comparisons):
 //   BM_Clustering_RefinedElephant   268 / 297 ms median (two runs of 4 repetitions), same
