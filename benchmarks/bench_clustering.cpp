@@ -307,8 +307,10 @@ void run_elephant(benchmark::State& state, elephant_scene& e) {
   state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
 }
 
-// With --benchmark_repetitions, the minimum too: on a shared VM the median moves with the
-// neighbours' load (the same binary 340-470 ms within minutes) while the minimum moves less.
+// With --benchmark_repetitions, the minimum too: on a shared VM every repetition is slowed by
+// the neighbours' load (the same binary 340-470 ms within minutes), and the minimum is the
+// repetition it slowed least. It is not steadier than the median: three runs of stop 20 gave
+// medians 413-423 ms and minimums 364-419.
 double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
 void BM_Clustering_RefinedElephant(benchmark::State& state) { run_elephant(state, elephant()); }
