@@ -39,4 +39,14 @@ result<walkthrough_scene> make_walkthrough_scene();
 // The street view of the experiment: from the end of the street toward the portico.
 pinhole_camera walkthrough_camera(std::uint32_t width, std::uint32_t height);
 
+// The paper's three kinds of view (§5): down the street with the portico's column shadows, along
+// the long city wall (many triangles in view once refined), and the temple column whose long
+// shadow crosses large ground triangles without touching a vertex.
+enum class walkthrough_view : std::uint8_t { street, wall, temple };
+pinhole_camera walkthrough_camera(walkthrough_view view, std::uint32_t width, std::uint32_t height);
+
+// Frame `frame` of a path of `frames` cameras: from the street view into the temple view over
+// the first half, back along the same way over the second (frame f and frames - 1 - f coincide).
+pinhole_camera walkthrough_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t width, std::uint32_t height);
+
 }  // namespace infolerp::support

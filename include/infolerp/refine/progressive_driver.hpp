@@ -18,7 +18,8 @@
 // triangle, ~3 triangles per vertex). With driver_options.max_cached_samples set, shaded
 // vertices outside the current view are evicted least recently visible first (ties by id)
 // whenever more are held; vertices of the current view are never evicted, so one view that
-// alone needs more than the bound exceeds it, and refinement stops (cache_full) at the bound.
+// alone needs more than the bound exceeds it, and refinement stops (cache_full) once the
+// current view's vertices alone reach the bound.
 //
 // Shading. Every vertex of a shown leaf, and every corner of its ancestors (the display falls
 // back to them, see below), is requested once: take_requests() hands out shading_points
@@ -188,6 +189,7 @@ class progressive_refiner {
     std::vector<hit> hits;
     if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
     reset();
+    selected_.clear();
     apply_view(camera, hits, exec);
     shade_requests(shade, exec);
     record_stage1();
@@ -376,6 +378,8 @@ class progressive_refiner {
   [[nodiscard]] std::span<const std::uint32_t> pixel_leaves() const noexcept { return pixel_leaf_; }
   [[nodiscard]] std::span<const std::uint32_t> visible_leaves() const noexcept { return visible_; }
   [[nodiscard]] std::span<const std::uint32_t> leaf_pixels() const noexcept { return leaf_pixels_; }
+  // The triangles the criterion selected in the last batch.
+  [[nodiscard]] std::span<const std::uint32_t> last_selection() const noexcept { return selected_; }
   // The shown set (ascending): equals visible_leaves() once every request is delivered.
   [[nodiscard]] std::span<const std::uint32_t> shown_triangles() const noexcept { return shown_; }
   // Shaded colour of a vertex (meaningful when vertex_shaded(v)).
@@ -476,6 +480,7 @@ class progressive_refiner {
     issued_ = 0;
     outstanding_ = 0;
     shaded_count_ = 0;
+    in_view_vertices_ = 0;
     samples_ = 0;
     l_max_ = 0.0f;
     clock_ = 0;
@@ -508,7 +513,7 @@ class progressive_refiner {
 
   [[nodiscard]] bool done() const {
     return finished_ || report_.stage2.shading_samples >= options_.max_shading_samples ||
-           report_.batches >= options_.max_batches || shaded_count_ >= options_.max_cached_samples;
+           report_.batches >= options_.max_batches || cache_full();
   }
 
   void record_stage1() {
@@ -530,7 +535,7 @@ class progressive_refiner {
       if (outstanding_ > 0) return b == 0 ? refine_progress::waiting : refine_progress::refined;
       record_stage1();
       if (finished_) return b == 0 ? refine_progress::finished : refine_progress::refined;
-      if (shaded_count_ >= options_.max_cached_samples) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
+      if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
       if (options_.criteria.criterion == refinement_criterion::nld_is) luminance_image(exec);
       selected_.clear();
       select_for_refinement(frame(), options_.criteria, state_, selected_);
@@ -619,11 +624,13 @@ class progressive_refiner {
       if (!ever_shown_[t]) ever_shown_[t] = 1, ++ever_shown_count_;
     // In view: the visible leaves and their ancestors; their corners are stamped and requested.
     ++clock_;
+    in_view_vertices_ = 0;
     for (std::uint32_t leaf : visible_)
       for (std::uint32_t t = leaf; t != invalid_id && in_view_[t] != clock_; t = mesh_.triangle(t).parent) {
         in_view_[t] = clock_;
         const glm::uvec3 v = mesh_.triangle(t).vertices;
         for (int c = 0; c < 3; ++c) {
+          if (last_seen_[v[c]] != clock_) ++in_view_vertices_;
           last_seen_[v[c]] = clock_;
           if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_;
         }
@@ -631,6 +638,9 @@ class progressive_refiner {
     enforce_cache_bound();
     update_display();
   }
+
+  // The current view alone fills the cache: nothing is left to evict.
+  [[nodiscard]] bool cache_full() const noexcept { return in_view_vertices_ >= options_.max_cached_samples; }
 
   [[nodiscard]] bool ready(std::uint32_t t) const {
     const glm::uvec3 v = mesh_.triangle(t).vertices;
@@ -730,6 +740,7 @@ class progressive_refiner {
   std::size_t issued_ = 0;
   std::size_t outstanding_ = 0;
   std::size_t shaded_count_ = 0;
+  std::size_t in_view_vertices_ = 0;  // vertices stamped with the current clock_
   std::vector<std::uint32_t> shown_, sent_, path_, evict_;
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
