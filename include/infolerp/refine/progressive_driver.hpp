@@ -186,13 +186,26 @@ class progressive_refiner {
   template <class T, class Camera, class Shade, class E>
   status start(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
     static_assert(check_shade<Shade>());
+    const auto began = std::chrono::steady_clock::now();
     std::vector<hit> hits;
     if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
     reset();
-    selected_.clear();
-    apply_view(camera, hits, exec);
+    apply_view(camera, hits, exec, began);
     shade_requests(shade, exec);
     record_stage1();
+    return {};
+  }
+
+  // Full restart with asynchronous shading: as start() above, but stage 1's requests are left
+  // outstanding for take_requests()/deliver(). Errors: those of set_view(); on error the
+  // refiner is unchanged.
+  template <class T, class Camera, class E>
+  status start(const T& tracer, const Camera& camera, E&& exec) {
+    const auto began = std::chrono::steady_clock::now();
+    std::vector<hit> hits;
+    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
+    reset();
+    apply_view(camera, hits, exec, began);
     return {};
   }
 
@@ -206,9 +219,10 @@ class progressive_refiner {
   // allocation O(pixels + triangles + vertices).
   template <class T, class Camera, class E>
   status set_view(const T& tracer, const Camera& camera, E&& exec) {
+    const auto began = std::chrono::steady_clock::now();
     std::vector<hit> hits;
     if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
-    apply_view(camera, hits, exec);
+    apply_view(camera, hits, exec, began);
     return {};
   }
 
@@ -465,6 +479,7 @@ class progressive_refiner {
 
   void reset() {
     mesh_ = initial_mesh_;
+    selected_.clear();
     state_ = criterion_state{};
     state_.rng = splitmix64{options_.criteria.seed};
     pixel_luminance_.clear();
@@ -490,8 +505,9 @@ class progressive_refiner {
   }
 
   template <class Camera, class E>
-  void apply_view(const Camera& camera, const std::vector<hit>& hits, E&& exec) {
-    started_ = std::chrono::steady_clock::now();
+  void apply_view(const Camera& camera, const std::vector<hit>& hits, E&& exec,
+                  std::chrono::steady_clock::time_point began) {
+    started_ = began;
     width_ = camera.width;
     height_ = camera.height;
     const std::size_t n = hits.size();
