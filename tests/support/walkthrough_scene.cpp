@@ -103,4 +103,19 @@ pinhole_camera walkthrough_path(std::uint32_t frame, std::uint32_t frames, std::
   return c;
 }
 
+image leaf_wireframe(const progressive_refiner& r, std::uint32_t w, std::uint32_t h) {
+  image img(static_cast<int>(w), static_cast<int>(h));
+  r.reconstruct(img.pixels);
+  const auto leaf = r.pixel_leaves();
+  std::vector<glm::vec3> out = img.pixels;
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      const bool edge = (x + 1 < w && leaf[p + 1] != leaf[p]) || (y + 1 < h && leaf[p + w] != leaf[p]);
+      if (edge && leaf[p] != invalid_id) out[p] = glm::vec3(0.05f, 0.9f, 1.0f) * 0.6f + 0.4f * img.pixels[p];
+    }
+  img.pixels = std::move(out);
+  return img;
+}
+
 }  // namespace infolerp::support
