@@ -329,3 +329,36 @@ TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(std::move(*s), {.max_cached_samples = 0}).error().code() == errc::bad_parameter);
 }
+
+TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS stops at its pixel fraction") {
+  serial_executor ex;
+  auto r = make_agent();
+  const pinhole_camera street = support::walkthrough_camera(support::walkthrough_view::street, W, H);
+  for (const pinhole_camera& cam : {street, support::walkthrough_camera(support::walkthrough_view::wall, W, H)}) {
+    REQUIRE(r.set_view(scene(), cam, ex).ok());
+    r.shade_requests(shader(), ex);
+    const auto before = image_of(r);
+    float l_max = 0.0f;
+    for (const glm::vec3& c : before) l_max = std::max(l_max, luminance(c));
+    REQUIRE(r.refine(ex) == refine_progress::refined);  // L_max taken from `before`, then the split
+    CHECK(r.frame().l_max == l_max);
+    r.shade_requests(shader(), ex);
+  }
+  // NLD_IS: without a fraction it runs to its own end; with 2% of the pixels it stops there.
+  const std::size_t pixels = std::size_t(W) * H;
+  auto free_run = make_agent({.criteria = {.criterion = refinement_criterion::nld_is, .batch = 4}});
+  auto limited = make_agent({.criteria = {.criterion = refinement_criterion::nld_is, .batch = 4, .nld_is_pixel_fraction = 0.02f}});
+  auto a = free_run.run(scene(), street, shader(), ex);
+  auto b = limited.run(scene(), street, shader(), ex);
+  REQUIRE((a.ok() && b.ok()));
+  const double cap = 0.02 * double(pixels);
+  INFO("free " << a->stage2.shading_samples << ", limited " << b->stage2.shading_samples << ", cap " << cap);
+  CHECK(double(a->stage2.shading_samples) > cap + 4 * 12);
+  CHECK(double(b->stage2.shading_samples) >= cap);
+  CHECK(double(b->stage2.shading_samples) <= cap + 4 * 12);  // one batch of R = 4 may overshoot (<= 12 vertices each)
+  CHECK(!b->budget_reached);  // the criterion's own rule ended it
+  auto bad = subdivision_mesh::build(scene().mesh);
+  REQUIRE(bad.ok());
+  CHECK(progressive_refiner::create(std::move(*bad), {.criteria = {.nld_is_pixel_fraction = -1.0f}}).error().code() ==
+        errc::bad_parameter);
+}

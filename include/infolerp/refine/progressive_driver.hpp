@@ -31,6 +31,10 @@
 // when no request is outstanding, so images and figures are bit-identical for any executor and
 // any delivery order.
 //
+// L_max (§4): the largest interpolated luminance of the current image, recomputed before every
+// selection. The paper takes luminance from Drago et al.'s tone mapper; we use the Rec. 709
+// luminance of the linear colour (nld.hpp), a linear map, under which S is scale-free.
+//
 // Display. A triangle is shown once its three corners are shaded; a split triangle stays shown
 // until every child leading to a shown leaf is ready (the paper: "whenever a triangle's
 // children are shaded ... display the new triangles and delete the original one"). The shown
@@ -272,7 +276,6 @@ class progressive_refiner {
       colour_[v] = colours[i];
       luminance_[v] = luminance(colours[i]);
       delivered_epoch_[v] = delta_epoch_;
-      l_max_ = std::max(l_max_, luminance_[v]);
     }
     outstanding_ -= vertices.size();
     samples_ += vertices.size();
@@ -414,6 +417,7 @@ class progressive_refiner {
     f.visible = visible_;
     f.vertex_luminance = luminance_;
     f.l_max = l_max_;
+    f.view_samples = view_requests_;
     return f;
   }
 
@@ -499,6 +503,7 @@ class progressive_refiner {
     samples_ = 0;
     l_max_ = 0.0f;
     clock_ = 0;
+    view_requests_ = 0;
     delta_epoch_ = 0;
     shown_.clear();
     sent_.clear();
@@ -521,6 +526,7 @@ class progressive_refiner {
     }
     finished_ = false;
     stage1_recorded_ = false;
+    view_requests_ = 0;
     state_.points_drawn = 0;
     state_.exhausted = false;
     report_ = {};
@@ -552,7 +558,7 @@ class progressive_refiner {
       record_stage1();
       if (finished_) return b == 0 ? refine_progress::finished : refine_progress::refined;
       if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
-      if (options_.criteria.criterion == refinement_criterion::nld_is) luminance_image(exec);
+      luminance_image(exec);  // also L_max
       selected_.clear();
       select_for_refinement(frame(), options_.criteria, state_, selected_);
       if (selected_.empty()) {
@@ -648,7 +654,7 @@ class progressive_refiner {
         for (int c = 0; c < 3; ++c) {
           if (last_seen_[v[c]] != clock_) ++in_view_vertices_;
           last_seen_[v[c]] = clock_;
-          if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_;
+          if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_, ++view_requests_;
         }
       }
     enforce_cache_bound();
@@ -726,12 +732,15 @@ class progressive_refiner {
     return sp;
   }
 
+  // The interpolated luminance per pixel and L_max, its maximum over the image (§4).
   template <class E>
   void luminance_image(E&& exec) {
     pixel_luminance_.resize(pixel_leaf_.size());
     exec.parallel_for(pixel_leaf_.size(), options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) pixel_luminance_[p] = luminance(pixel_colour(p));
     });
+    l_max_ = 0.0f;
+    for (float l : pixel_luminance_) l_max_ = std::max(l_max_, l);
   }
 
   subdivision_mesh initial_mesh_, mesh_;
@@ -757,6 +766,7 @@ class progressive_refiner {
   std::size_t outstanding_ = 0;
   std::size_t shaded_count_ = 0;
   std::size_t in_view_vertices_ = 0;  // vertices stamped with the current clock_
+  std::size_t view_requests_ = 0;     // requests issued since the view was set
   std::vector<std::uint32_t> shown_, sent_, path_, evict_;
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
