@@ -59,16 +59,6 @@ namespace {
 
 using scene = infolerp::support::walkthrough_scene;
 
-double psnr(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-  double se = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const glm::dvec3 d = glm::dvec3(glm::clamp(a[i], 0.0f, 1.0f)) - glm::dvec3(glm::clamp(b[i], 0.0f, 1.0f));
-    se += glm::dot(d, d) / 3.0;
-  }
-  const double mse = se / double(a.size());
-  return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
-}
-
 // The images beside the CSV are PNGs (support::write_png, sRGB); the PSNR above stays on
 // linear values, as the CSV always measured it.
 void write_image(const std::string& path, const std::vector<glm::vec3>& pixels, std::uint32_t w, std::uint32_t h) {
@@ -114,8 +104,8 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   }
   r->reconstruct(out.image2);
   out.report = r->report();
-  out.psnr1 = psnr(out.image1, reference);
-  out.psnr2 = psnr(out.image2, reference);
+  out.psnr1 = linear_psnr(out.image1, reference);
+  out.psnr2 = linear_psnr(out.image2, reference);
   return out;
 }
 

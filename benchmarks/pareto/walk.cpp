@@ -38,16 +38,6 @@ using clock_type = std::chrono::steady_clock;
 
 double seconds_since(clock_type::time_point t) { return std::chrono::duration<double>(clock_type::now() - t).count(); }
 
-double psnr(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-  double se = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const glm::dvec3 d = glm::dvec3(glm::clamp(a[i], 0.0f, 1.0f)) - glm::dvec3(glm::clamp(b[i], 0.0f, 1.0f));
-    se += glm::dot(d, d) / 3.0;
-  }
-  const double mse = se / double(a.size());
-  return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
-}
-
 std::vector<glm::vec3> reference_image(const scene& sc, const infolerp::pinhole_camera& cam) {
   std::vector<glm::vec3> img(std::size_t(cam.width) * cam.height, glm::vec3(0.0f));
   infolerp::support::enable_flush_to_zero();
@@ -130,7 +120,7 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
   row.samples = agent.samples_delivered() - before;
   std::vector<glm::vec3> img(reference.size());
   agent.reconstruct(img);
-  row.psnr_db = psnr(img, reference);
+  row.psnr_db = linear_psnr(img, reference);
   return row;
 }
 

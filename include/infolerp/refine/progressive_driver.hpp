@@ -190,11 +190,7 @@ class progressive_refiner {
   template <class T, class Camera, class Shade, class E>
   status start(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
     static_assert(check_shade<Shade>());
-    const auto began = std::chrono::steady_clock::now();
-    std::vector<hit> hits;
-    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
-    reset();
-    apply_view(camera, hits, exec, began);
+    if (auto st = start(tracer, camera, exec); !st) return st;
     shade_requests(shade, exec);
     record_stage1();
     return {};
@@ -205,12 +201,7 @@ class progressive_refiner {
   // refiner is unchanged.
   template <class T, class Camera, class E>
   status start(const T& tracer, const Camera& camera, E&& exec) {
-    const auto began = std::chrono::steady_clock::now();
-    std::vector<hit> hits;
-    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
-    reset();
-    apply_view(camera, hits, exec, began);
-    return {};
+    return view(tracer, camera, exec, true);
   }
 
   // A new view: visibility recomputed, hierarchy and cache kept, requests issued for the newly
@@ -223,11 +214,7 @@ class progressive_refiner {
   // allocation O(pixels + triangles + vertices).
   template <class T, class Camera, class E>
   status set_view(const T& tracer, const Camera& camera, E&& exec) {
-    const auto began = std::chrono::steady_clock::now();
-    std::vector<hit> hits;
-    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
-    apply_view(camera, hits, exec, began);
-    return {};
+    return view(tracer, camera, exec, false);
   }
 
   // Appends up to max_count outstanding requests, oldest first, and hands them out (each is
@@ -450,6 +437,17 @@ class progressive_refiner {
       if (!(fov > 0.0f && fov < 180.0f))
         return make_error(errc::bad_parameter, no_element, "camera vertical_fov_degrees ", fov, " outside (0, 180)");
     }
+    return {};
+  }
+
+  // Traces and checks the view; only then (optionally) restarts and takes the view.
+  template <class T, class Camera, class E>
+  status view(const T& tracer, const Camera& camera, E&& exec, bool restart) {
+    const auto began = std::chrono::steady_clock::now();
+    std::vector<hit> hits;
+    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
+    if (restart) reset();
+    apply_view(camera, hits, exec, began);
     return {};
   }
 
