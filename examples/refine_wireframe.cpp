@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
-#include <vector>
 #include "infolerp/core/executor.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/image.hpp"
@@ -19,22 +18,6 @@
 namespace sup = infolerp::support;
 
 namespace {
-
-// The reconstructed image with leaf boundaries darkened to a wire colour.
-sup::image with_wireframe(const infolerp::progressive_refiner& r, std::uint32_t w, std::uint32_t h) {
-  sup::image img(static_cast<int>(w), static_cast<int>(h));
-  r.reconstruct(img.pixels);
-  const auto leaf = r.pixel_leaves();
-  std::vector<glm::vec3> out = img.pixels;
-  for (std::uint32_t y = 0; y < h; ++y)
-    for (std::uint32_t x = 0; x < w; ++x) {
-      const std::size_t p = std::size_t(y) * w + x;
-      const bool edge = (x + 1 < w && leaf[p + 1] != leaf[p]) || (y + 1 < h && leaf[p + w] != leaf[p]);
-      if (edge && leaf[p] != infolerp::invalid_id) out[p] = glm::vec3(0.05f, 0.9f, 1.0f) * 0.6f + 0.4f * img.pixels[p];
-    }
-  img.pixels = std::move(out);
-  return img;
-}
 
 bool parse(const char* text, std::uint32_t& out) {
   const std::string_view s(text);
@@ -72,10 +55,10 @@ int main(int argc, char** argv) {
 #endif
   if (auto s = refiner->start(*scene, cam, shade, exec); !s)
     return std::fprintf(stderr, "refine_wireframe: %s\n", s.message().c_str()), 1;
-  const sup::image stage1 = with_wireframe(*refiner, width, height);
+  const sup::image stage1 = sup::leaf_wireframe(*refiner, width, height);
   while (refiner->refine_batch(shade, exec)) {
   }
-  const sup::image stage2 = with_wireframe(*refiner, width, height);
+  const sup::image stage2 = sup::leaf_wireframe(*refiner, width, height);
 
   const auto& rep = refiner->report();
   std::printf("stage 1: %zu triangles shown, %zu shading samples, %.3f s\n", rep.stage1.triangles,

@@ -1,5 +1,24 @@
 #pragma once
 // Subcommands of infolerp_pareto, the time-against-error harness: each lives in its own
 // benchmarks/pareto/<sub>.cpp. Weak, so that the binary links while a subcommand's file is absent.
+#include <cmath>
+#include <vector>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
 [[gnu::weak]] int pareto_refine(int argc, char** argv);
 [[gnu::weak]] int pareto_upsample(int argc, char** argv);
+[[gnu::weak]] int pareto_walk(int argc, char** argv);
+
+// PSNR in dB of image a against reference b on linear colours clamped to [0, 1] (99 when equal),
+// as the refinement harnesses measure it.
+inline double linear_psnr(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  double se = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const glm::dvec3 d = glm::dvec3(glm::clamp(a[i], 0.0f, 1.0f)) - glm::dvec3(glm::clamp(b[i], 0.0f, 1.0f));
+    se += glm::dot(d, d) / 3.0;
+  }
+  const double mse = se / double(a.size());
+  return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
+}

@@ -13,6 +13,8 @@
 #include <tuple>
 #include <vector>
 #include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/matrix.hpp>
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 #include "support/mesh_io.hpp"
@@ -396,4 +398,115 @@ TEST_CASE("subdivision: §4.1 tessellation to a screen fraction") {
   REQUIRE(capped.ok());
   capped->tessellate(infolerp::screen_fraction_test{.max_fraction = 1e-9f}, 2);
   CHECK(capped->leaf_count() == 2 * 16);
+}
+
+namespace {
+// Brute-force screen fraction: a ray from the eye through each cell centre of a grid over NDC,
+// intersected with the triangle in world space; a hit counts when its view depth lies between
+// the near and far planes (what the view volume keeps).
+double ray_cast_screen_fraction(glm::vec3 eye, const glm::mat4& view, float fovy, float aspect, float znear,
+                                float zfar, glm::vec3 a, glm::vec3 b, glm::vec3 c, int grid) {
+  const glm::mat4 inv = glm::inverse(view);
+  const double h = std::tan(0.5 * fovy);
+  int hits = 0;
+  for (int j = 0; j < grid; ++j)
+    for (int i = 0; i < grid; ++i) {
+      const double x = (2.0 * (i + 0.5) / grid - 1.0) * h * aspect, y = (2.0 * (j + 0.5) / grid - 1.0) * h;
+      const glm::dvec3 d = glm::dvec3(glm::mat3(inv) * glm::vec3(float(x), float(y), -1.0f));  // view depth 1
+      const glm::dvec3 o(eye), e1 = glm::dvec3(b) - glm::dvec3(a), e2 = glm::dvec3(c) - glm::dvec3(a);
+      const glm::dvec3 pv = glm::cross(d, e2);
+      const double det = glm::dot(e1, pv);
+      if (std::abs(det) < 1e-12) continue;
+      const glm::dvec3 tv = o - glm::dvec3(a);
+      const double u = glm::dot(tv, pv) / det;
+      const glm::dvec3 qv = glm::cross(tv, e1);
+      const double v = glm::dot(d, qv) / det, t = glm::dot(e2, qv) / det;  // t = view depth (|d.z| = 1)
+      if (u >= 0 && v >= 0 && u + v <= 1 && t >= znear && t <= zfar) ++hits;
+    }
+  return double(hits) / double(grid * grid);
+}
+}  // namespace
+
+TEST_CASE("subdivision: the screen fraction is the on-screen area, clipped to the view volume") {
+  const glm::vec3 eye{0.3f, 1.5f, 4.0f};
+  const glm::mat4 view = glm::lookAt(eye, glm::vec3(0.0f, 0.0f, -2.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+  const float fovy = glm::radians(60.0f), aspect = 4.0f / 3.0f, znear = 0.1f, zfar = 100.0f;
+  const infolerp::screen_fraction_test test{.view_projection = glm::perspective(fovy, aspect, znear, zfar) * view};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-8.0f, 8.0f);
+  int behind = 0, crossing = 0, outside = 0, inside = 0;
+  for (int k = 0; k < 200; ++k) {
+    const glm::vec3 a{u(rng), u(rng) * 0.5f, u(rng)}, b{u(rng), u(rng) * 0.5f, u(rng)}, c{u(rng), u(rng) * 0.5f, u(rng)};
+    const double reference = ray_cast_screen_fraction(eye, view, fovy, aspect, znear, zfar, a, b, c, 160);
+    const float fraction = test.screen_fraction(a, b, c);
+    // One grid cell along the projected boundary: the reference's resolution.
+    CHECK(std::abs(fraction - reference) <= 0.03 + 0.05 * reference);
+    const auto depth = [&](glm::vec3 p) { return -(view * glm::vec4(p, 1.0f)).z; };
+    const int in_front = (depth(a) > 0) + (depth(b) > 0) + (depth(c) > 0);
+    if (in_front == 0) {
+      ++behind;
+      CHECK(fraction == 0.0f);
+    } else if (in_front < 3) {
+      ++crossing;
+    } else if (reference == 0.0) {
+      ++outside;
+    } else {
+      ++inside;
+    }
+  }
+  // The random triangles cover every case.
+  CHECK(behind > 0);
+  CHECK(crossing > 0);
+  CHECK(outside > 0);
+  CHECK(inside > 0);
+}
+
+TEST_CASE("subdivision: tessellation never splits triangles behind the eye or outside the frustum") {
+  // A 64 x 64 ground plane (z = 0 in the mesh, rotated to y = 0) with the eye in its middle,
+  // looking along -z: half the plane lies behind the eye, much of the rest outside the frustum.
+  const auto plane = infolerp::support::make_plane(4, 4, 64.0f);
+  indexed_mesh ground;
+  infolerp::support::append(ground, plane, glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(1, 0, 0)));
+  auto s = subdivision_mesh::build(ground);
+  REQUIRE(s.ok());
+  const glm::vec3 eye{0.0f, 1.0f, 0.0f};
+  const glm::mat4 view = glm::lookAt(eye, glm::vec3(0.0f, 0.8f, -5.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+  const infolerp::screen_fraction_test test{
+      .view_projection = glm::perspective(glm::radians(60.0f), 4.0f / 3.0f, 0.1f, 100.0f) * view, .max_fraction = 0.01f};
+  const std::size_t selections = s->tessellate(test, 8);
+  CHECK(selections > 0);
+  check_invariants(*s, ground);
+  // No triangle wholly behind the eye is split 1:4 (1:2 closure splits next to split
+  // neighbours are allowed: they keep the mesh conforming).
+  std::size_t split_behind = 0, visible_leaves = 0;
+  for (const auto& n : s->triangles()) {
+    const glm::vec3 p[3] = {s->position(n.vertices.x), s->position(n.vertices.y), s->position(n.vertices.z)};
+    bool all_behind = true;
+    for (const glm::vec3& q : p) all_behind = all_behind && -(view * glm::vec4(q, 1.0f)).z <= 0.0f;
+    if (n.child_count == 4 && all_behind) ++split_behind;
+    if (n.is_leaf() && test.screen_fraction(p[0], p[1], p[2]) > 0.0f) {
+      ++visible_leaves;
+      CHECK((n.level == 8 || test.screen_fraction(p[0], p[1], p[2]) <= 0.01f));
+    }
+  }
+  INFO("leaves " << s->leaf_count());
+  CHECK(split_behind == 0);
+  CHECK(visible_leaves > 0);
+  CHECK(s->leaf_count() < 32 * 4096);
+}
+
+TEST_CASE("subdivision: tessellation leaves a mesh behind the eye or beside the frustum alone") {
+  const auto plane = infolerp::support::make_plane(4, 4, 8.0f);  // z = 0, facing +z
+  const glm::mat4 projection = glm::perspective(glm::radians(60.0f), 4.0f / 3.0f, 0.1f, 100.0f);
+  const glm::vec3 looks[] = {glm::vec3(0.0f, 0.0f, 10.0f),    // behind the eye (looking away)
+                             glm::vec3(40.0f, 0.0f, -5.0f),   // far to the side
+                             glm::vec3(0.0f, -40.0f, -5.0f)};  // far below
+  for (const glm::vec3 look : looks) {
+    INFO("looking along " << look.x << " " << look.y << " " << look.z);
+    auto s = subdivision_mesh::build(plane);
+    REQUIRE(s.ok());
+    const glm::mat4 view = glm::lookAt(glm::vec3(0.0f, 0.0f, 5.0f), glm::vec3(0.0f, 0.0f, 5.0f) + look, glm::vec3(0, 1, 0));
+    CHECK(s->tessellate(infolerp::screen_fraction_test{.view_projection = projection * view, .max_fraction = 1e-6f}) == 0);
+    CHECK(s->triangle_count() == plane.triangles.size());
+  }
 }

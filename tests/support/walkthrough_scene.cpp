@@ -1,5 +1,7 @@
 #include "support/walkthrough_scene.hpp"
 
+#include <algorithm>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include "support/procedural.hpp"
 
@@ -70,6 +72,50 @@ result<walkthrough_scene> make_walkthrough_scene() {
 pinhole_camera walkthrough_camera(std::uint32_t width, std::uint32_t height) {
   return {.eye = {0.0f, -19.0f, 5.5f}, .target = {0.0f, 1.0f, 1.0f}, .up = {0, 0, 1}, .vertical_fov_degrees = 55.0f,
           .width = width, .height = height};
+}
+
+pinhole_camera walkthrough_camera(walkthrough_view view, std::uint32_t width, std::uint32_t height) {
+  pinhole_camera c = walkthrough_camera(width, height);
+  switch (view) {
+    case walkthrough_view::street: break;
+    case walkthrough_view::wall:
+      c.eye = {-5.0f, -13.0f, 2.2f};
+      c.target = {-15.0f, -3.0f, 1.8f};
+      break;
+    case walkthrough_view::temple:
+      c.eye = {9.0f, -15.0f, 4.0f};
+      c.target = {2.5f, -5.0f, 1.0f};
+      break;
+  }
+  return c;
+}
+
+pinhole_camera walkthrough_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t width, std::uint32_t height) {
+  const pinhole_camera a = walkthrough_camera(walkthrough_view::street, width, height);
+  const pinhole_camera b = walkthrough_camera(walkthrough_view::temple, width, height);
+  const std::uint32_t last = frames > 1 ? frames - 1 : 1;
+  const std::uint32_t k = std::min(frame, last - std::min(frame, last));  // frames from the nearer end
+  const float t = std::min(1.0f, 2.0f * float(k) / float(last));
+  const float s = t * t * (3.0f - 2.0f * t);  // smoothstep: slow at both ends
+  pinhole_camera c = a;
+  c.eye = glm::mix(a.eye, b.eye, s);
+  c.target = glm::mix(a.target, b.target, s);
+  return c;
+}
+
+image leaf_wireframe(const progressive_refiner& r, std::uint32_t w, std::uint32_t h) {
+  image img(static_cast<int>(w), static_cast<int>(h));
+  r.reconstruct(img.pixels);
+  const auto leaf = r.pixel_leaves();
+  std::vector<glm::vec3> out = img.pixels;
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const std::size_t p = std::size_t(y) * w + x;
+      const bool edge = (x + 1 < w && leaf[p + 1] != leaf[p]) || (y + 1 < h && leaf[p + w] != leaf[p]);
+      if (edge && leaf[p] != invalid_id) out[p] = glm::vec3(0.05f, 0.9f, 1.0f) * 0.6f + 0.4f * img.pixels[p];
+    }
+  img.pixels = std::move(out);
+  return img;
 }
 
 }  // namespace infolerp::support

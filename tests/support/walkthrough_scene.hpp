@@ -13,6 +13,7 @@
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/embree_tracer.hpp"
+#include "support/image.hpp"
 
 namespace infolerp::support {
 
@@ -38,5 +39,19 @@ result<walkthrough_scene> make_walkthrough_scene();
 
 // The street view of the experiment: from the end of the street toward the portico.
 pinhole_camera walkthrough_camera(std::uint32_t width, std::uint32_t height);
+
+// The paper's three kinds of view (§5): down the street with the portico's column shadows, along
+// the long city wall (many triangles in view once refined), and the temple column whose long
+// shadow crosses large ground triangles without touching a vertex.
+enum class walkthrough_view : std::uint8_t { street, wall, temple };
+pinhole_camera walkthrough_camera(walkthrough_view view, std::uint32_t width, std::uint32_t height);
+
+// Frame `frame` of a path of `frames` cameras: from the street view into the temple view over
+// the first half, back along the same way over the second (frame f and frames - 1 - f coincide).
+pinhole_camera walkthrough_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t width, std::uint32_t height);
+
+// The refiner's current image with the boundaries between the leaves under neighbouring
+// pixels drawn in a wire colour (so hidden edges are not drawn).
+image leaf_wireframe(const progressive_refiner& r, std::uint32_t width, std::uint32_t height);
 
 }  // namespace infolerp::support

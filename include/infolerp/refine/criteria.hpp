@@ -12,7 +12,9 @@
 //    first (largest first), then by S (largest first), ties by id; it takes the first R.
 //  - NLD_IS is a best-first walk of the image quadtree: the quadrant with the largest S (over
 //    its four corner pixels) is expanded first; while S > S_req the triangle under its centre is
-//    selected (once) and its four sub-quadrants are queued, down to one pixel.
+//    selected (once) and its four sub-quadrants are queued, down to one pixel. It also ends
+//    (§4) once the samples requested in the current view reach `nld_is_pixel_fraction` of the
+//    pixel count (checked per batch, so the last batch may overshoot by its own requests).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
@@ -20,6 +22,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <queue>
 #include <span>
 #include <vector>
@@ -48,6 +51,7 @@ struct criteria_options {
   float always_refine_fraction = 0.02f;  // NLD_OS: refine triangles covering more of the image regardless of S
   std::uint32_t batch = 64;              // R: triangles selected per batch
   float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count
+  float nld_is_pixel_fraction = std::numeric_limits<float>::infinity();  // NLD_IS: stop once the view's requests reach this fraction of the pixels
   std::uint64_t seed = 1;                // RND: random sequence
 };
 
@@ -60,6 +64,8 @@ inline status validate(const criteria_options& o) {
   if (!(o.always_refine_fraction > 0.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.always_refine_fraction must be > 0");
   if (o.batch == 0) return make_error(errc::bad_parameter, no_element, "criteria_options.batch must be >= 1");
+  if (!(o.nld_is_pixel_fraction >= 0.0f))
+    return make_error(errc::bad_parameter, no_element, "criteria_options.nld_is_pixel_fraction must be >= 0");
   if (!(o.rnd_point_fraction >= 0.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.rnd_point_fraction must be >= 0");
   return {};
@@ -75,7 +81,8 @@ struct refinement_frame {
   std::span<const std::uint32_t> leaf_pixels;      // per triangle: pixels it covers (projected area)
   std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, ascending
   std::span<const float> vertex_luminance;         // per vertex (valid for vertices of visible leaves)
-  float l_max = 0.0f;                              // largest luminance shaded so far
+  float l_max = 0.0f;                              // L_max: largest luminance of the current image
+  std::size_t view_samples = 0;                    // shading samples requested since the view was set
 };
 
 // What a criterion keeps between batches (RND's random stream and point count).
@@ -126,6 +133,7 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
 // Appends up to R ids. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
 inline void select_nld_is(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
   if (f.width == 0 || f.height == 0) return;
+  if (double(f.view_samples) >= double(o.nld_is_pixel_fraction) * double(f.width) * double(f.height)) return;
   struct quad {
     float s;
     std::uint32_t x0, y0, x1, y1;  // [x0, x1) × [y0, y1)

@@ -1,28 +1,60 @@
 #pragma once
-// Progressive refinement driver: Oliveira, Santos, Proença, "Refinement Criteria for High
-// Fidelity Interactive Walkthroughs", §2 (the Shading Management Agent: visibility, a vertex
-// shading cache, refinement in batches of R, the image interpolated from triangle vertices)
-// and §5 (the Table 1 figures: Δ, Δ_total, shading samples and time at stage 1 and stage 2).
+// Progressive refinement along a walkthrough: Oliveira, Santos, Proença, "Refinement Criteria
+// for High Fidelity Interactive Walkthroughs", §2 (the Shading Management Agent: visibility, an
+// object-space shading cache, asynchronous shading requests, the incremental add/delete
+// protocol), §4.1 (refinement interrupted after every R selections) and §5 (the Table 1
+// figures: Δ, Δ_total, shading samples and time at stage 1 and stage 2).
 //
-// One fixed view point. Visibility comes from one primary ray per pixel through the user's
-// tracer (core/tracer.hpp): the hit's triangle and barycentrics locate the pixel in the
-// subdivision hierarchy, so later splits re-locate pixels without tracing again (subdivision
-// is planar: the geometry does not change, only where it is sampled). A leaf's projected area
-// is the number of pixels it shows. The image is rebuilt by interpolating the colours of the
-// shown leaf's vertices with the pixel's barycentric weights.
+// Views. set_view() traces one primary ray per pixel through the user's tracer
+// (core/tracer.hpp): the hit's triangle and barycentrics locate the pixel in the subdivision
+// hierarchy, so later splits re-locate pixels without tracing again (subdivision is planar).
+// A leaf's projected area is the number of pixels it shows. The hierarchy and every shaded
+// value survive a view change; only leaves shown in the current view are refined, requested or
+// displayed. start() is a full restart: the hierarchy returns to the mesh given to create(),
+// the cache is emptied and every figure restarts.
 //
-//  stage 1: every vertex of every visible original triangle shaded once;
-//  stage 2: batches of R selections (criteria.hpp), each followed by re-location and shading
-//           of the new visible vertices, until the criterion selects nothing, the shading
+// Cache. One colour per hierarchy vertex (object space; the paper's Lambertian restriction):
+// 16 bytes + 4 bytes of visibility stamp per vertex plus the hierarchy itself (32 bytes per
+// triangle, ~3 triangles per vertex). With driver_options.max_cached_samples set, shaded
+// vertices outside the current view are evicted least recently visible first (ties by id)
+// whenever more are held; vertices of the current view are never evicted, so one view that
+// alone needs more than the bound exceeds it, and refinement stops (cache_full) once the
+// current view's vertices alone reach the bound.
+//
+// Shading. Every vertex of a shown leaf, and every corner of its ancestors (the display falls
+// back to them, see below), is requested once: take_requests() hands out shading_points
+// (vertex id, position, normal, original triangle), deliver() accepts colours for any subset
+// of outstanding requests in any order. The library never calls a renderer in this mode, so
+// requests may be shaded on other threads or machines; calls on one refiner must not overlap
+// (serialise deliveries from worker threads, e.g. with a mutex). shade_requests() is the
+// synchronous adaptor (shade on the executor, deliver at once). A refinement batch only runs
+// when no request is outstanding, so images and figures are bit-identical for any executor and
+// any delivery order.
+//
+// L_max (§4): the largest interpolated luminance of the current image, recomputed before every
+// selection. The paper takes luminance from Drago et al.'s tone mapper; we use the Rec. 709
+// luminance of the linear colour (nld.hpp), a linear map, under which S is scale-free.
+//
+// Display. A triangle is shown once its three corners are shaded; a split triangle stays shown
+// until every child leading to a shown leaf is ready (the paper: "whenever a triangle's
+// children are shaded ... display the new triangles and delete the original one"). The shown
+// set is thus always a cut of the hierarchy over the view, never overlapping. take_delta()
+// reports how it changed since the last call, in the paper's order: triangles added from the
+// cache, triangles deleted, triangles added with newly shaded corners.
+//
+//  stage 1: every vertex of every visible leaf shaded once (recorded at the first refine call);
+//  stage 2: batches of R selections (criteria.hpp), each followed by re-location and requests
+//           for the new visible vertices, until the criterion selects nothing, the shading
 //           budget is reached (checked after each batch, so one batch may overshoot it) or
 //           max_batches ran.
 //  Δ        leaves shown (visible) now;
-//  Δ_total  triangles ever shown (the paper: "sent to the visualizer", which counts split ones);
-//           triangles_produced additionally counts children never shown.
+//  Δ_total  triangles ever shown since start() (the paper: "sent to the visualizer", which
+//           counts split ones); triangles_produced additionally counts children never shown.
 //
 // The tracer must model infolerp::tracer; the scene's triangle ids must be the mesh's (the
-// hit's geometry id is ignored). The shading callback, glm::vec3 shade(const shading_point&),
-// is called once per vertex, concurrently from the executor's threads.
+// hit's geometry id is ignored). The synchronous shading callback,
+// glm::vec3 shade(const shading_point&), is called once per request, concurrently from the
+// executor's threads.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -74,6 +106,7 @@ struct pinhole_camera {
 struct shading_point {
   std::uint32_t vertex = invalid_id;     // vertex id in the subdivision mesh
   glm::vec3 position{0.0f};              // its world position
+  glm::vec3 normal{0.0f};                // unit geometric normal of `triangle`
   std::uint32_t triangle = invalid_id;   // an original triangle it lies in
   glm::vec2 barycentric{0.0f};           // Embree-style (u, v) of the position in that triangle
 };
@@ -97,108 +130,202 @@ struct driver_options {
   criteria_options criteria{};                                              // which criterion and its settings
   std::size_t max_shading_samples = std::numeric_limits<std::size_t>::max();  // stop once this many vertices are shaded
   std::size_t max_batches = std::numeric_limits<std::size_t>::max();          // stop after this many batches
-  glm::vec3 background{0.0f};                                              // colour of pixels without a hit
+  std::size_t max_cached_samples = std::numeric_limits<std::size_t>::max();  // cache bound (>= 1), see the prologue
+  glm::vec3 background{0.0f};                                              // colour of pixels without a hit or shown triangle
   std::size_t grain = 4096;                                                // executor grain (pixels, vertices)
+};
+
+// What one call of refine() did.
+enum class refine_progress : std::uint8_t {
+  refined,     // selected and split at least one batch; new requests may be waiting
+  waiting,     // requests are outstanding: deliver them first
+  finished,    // the criterion selects nothing more in this view
+  cache_full,  // the cache holds max_cached_samples: no further refinement in this view
+};
+
+// How much one refine() call may do (§4.1: control returns to the caller after R selections).
+struct refine_budget {
+  std::size_t batches = 1;                                         // batches of R selections
+  std::size_t samples = std::numeric_limits<std::size_t>::max();   // shading samples to request
+  double seconds = std::numeric_limits<double>::infinity();        // wall time, checked between batches
+};
+
+// The incremental protocol of §2: how the shown set changed, in the paper's order.
+struct display_delta {
+  std::vector<std::uint32_t> added_from_cache;  // shown now, every corner shaded before the last delta
+  std::vector<std::uint32_t> deleted;           // shown at the last delta, not now
+  std::vector<std::uint32_t> newly_shaded;      // shown now, a corner delivered since the last delta
+  void clear() {
+    added_from_cache.clear();
+    deleted.clear();
+    newly_shaded.clear();
+  }
 };
 
 // Not thread-safe: one call at a time per object (each call runs in parallel through the
 // executor). Accessors below are O(1) and allocate nothing.
 class progressive_refiner {
  public:
-  // Takes over a subdivision mesh (possibly already tessellated, §4.1 of the clustering paper).
-  // Errors: options out of range. O(1) besides the move; no allocation.
+  // Takes over a subdivision mesh (possibly already tessellated, §4.1 of the clustering paper);
+  // start() returns to it, so a copy is kept. Errors: options out of range (names the member).
+  // O(mesh) for the copy.
   static result<progressive_refiner> create(subdivision_mesh mesh, driver_options options = {}) {
     if (auto st = validate(options.criteria); !st) return st;
     if (options.grain == 0) return make_error(errc::bad_parameter, no_element, "driver_options.grain must be >= 1");
+    if (options.max_cached_samples == 0)
+      return make_error(errc::bad_parameter, no_element, "driver_options.max_cached_samples must be >= 1");
     progressive_refiner r;
+    r.initial_mesh_ = mesh;
     r.mesh_ = std::move(mesh);
     r.options_ = options;
     r.state_.rng = splitmix64{options.criteria.seed};
     return r;
   }
 
-  // Stage 1 in one call: traces the primary rays, locates every pixel, shades the visible
-  // vertices. Camera: any type with width, height and primary_ray(x, y) -> ray.
-  // Errors: an empty image; a hit naming a triangle the mesh does not have, or with a
-  // non-finite distance or barycentric (names the pixel). On error the refiner is unchanged.
+  // Full restart, then stage 1 in one call: set_view() on the mesh given to create() with an
+  // empty cache, and the requests shaded synchronously (shade_requests). Camera: any type with
+  // width, height and primary_ray(x, y) -> ray (checked further when it has eye/target/up).
+  // Errors: those of set_view(); on error the refiner is unchanged.
   // Complexity O(pixels · (trace + level)); allocation O(pixels + triangles + vertices).
   template <class T, class Camera, class Shade, class E>
   status start(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
-    static_assert(check_tracer<T>());
-    static_assert(check_executor<std::remove_cvref_t<E>>());
-    static_assert(std::is_invocable_r_v<glm::vec3, Shade&, const shading_point&>,
-                  "infolerp: shading callback needs `glm::vec3 shade(const infolerp::shading_point&)`");
-    const auto started = std::chrono::steady_clock::now();
-    const std::uint32_t width = camera.width, height = camera.height;
-    const std::size_t n = std::size_t(width) * height;
-    if (n == 0) return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
-    std::vector<hit> hits(n);
-    for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::vector<ray> rays(end - begin);
-      for (std::size_t p = begin; p < end; ++p)
-        rays[p - begin] = camera.primary_ray(static_cast<std::uint32_t>(p % width), static_cast<std::uint32_t>(p / width));
-      trace_intersect(tracer, std::span<const ray>(rays), std::span<hit>(hits.data() + begin, end - begin));
-    });
-    for (std::size_t p = 0; p < n; ++p) {  // check every hit before changing any state
-      const hit& h = hits[p];
-      if (!h.valid()) continue;
-      if (h.triangle >= mesh_.original_triangle_count())
-        return make_error(errc::index_out_of_range, p, "pixel ", p, ": hit triangle ", h.triangle,
-                          " is not in the mesh (", mesh_.original_triangle_count(), " triangles)");
-      if (!std::isfinite(h.distance) || !std::isfinite(h.barycentric.x) || !std::isfinite(h.barycentric.y))
-        return make_error(errc::non_finite, p, "pixel ", p, ": hit on triangle ", h.triangle,
-                          " has a non-finite distance or barycentric");
-    }
-    started_ = started;
-    width_ = width;
-    height_ = height;
-    pixel_leaf_.assign(n, invalid_id);
-    pixel_weights_.assign(n, glm::vec3(0.0f));
-    for (std::size_t p = 0; p < n; ++p) {
-      if (!hits[p].valid()) continue;
-      pixel_leaf_[p] = hits[p].triangle;
-      const glm::vec2 b = hits[p].barycentric;
-      pixel_weights_[p] = glm::vec3(1.0f - b.x - b.y, b.x, b.y);
-    }
-    relocate(exec);
-    shade_visible(shade, exec);
-    report_ = {};
-    report_.stage1 = figures();
-    report_.stage2 = report_.stage1;
+    static_assert(check_shade<Shade>());
+    if (auto st = start(tracer, camera, exec); !st) return st;
+    shade_requests(shade, exec);
+    record_stage1();
     return {};
   }
 
-  // One batch of stage 2: the criterion selects up to R leaves, they are split, pixels are
-  // re-located and new visible vertices shaded. Returns false when nothing was selected, the
-  // shading budget is reached or max_batches ran (then stage 2's figures are final).
-  // Preconditions: start() succeeded. Complexity: the criterion's selection (criteria.hpp) +
-  // O(R) splits + O(pixels of the split leaves) re-location + the new vertices' shading.
-  // Allocation: the split triangles and vertices, the visible-set rebuild (O(visible)).
+  // Full restart with asynchronous shading: as start() above, but stage 1's requests are left
+  // outstanding for take_requests()/deliver(). Errors: those of set_view(); on error the
+  // refiner is unchanged.
+  template <class T, class Camera, class E>
+  status start(const T& tracer, const Camera& camera, E&& exec) {
+    return view(tracer, camera, exec, true);
+  }
+
+  // A new view: visibility recomputed, hierarchy and cache kept, requests issued for the newly
+  // visible unshaded vertices, the criterion's per-view state (RND's draws) and the report
+  // restarted. May be called at any time, with requests outstanding (they stay valid).
+  // Errors: an empty image; a camera with non-finite eye/target/up, eye == target, up parallel
+  // to the view direction or a field of view outside (0, 180); a hit naming a triangle the
+  // mesh does not have or with a non-finite distance or barycentric (names the pixel). On error
+  // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level);
+  // allocation O(pixels + triangles + vertices).
+  template <class T, class Camera, class E>
+  status set_view(const T& tracer, const Camera& camera, E&& exec) {
+    return view(tracer, camera, exec, false);
+  }
+
+  // Appends up to max_count outstanding requests, oldest first, and hands them out (each is
+  // handed out once). Returns how many. O(returned); allocation: growth of out.
+  std::size_t take_requests(std::vector<shading_point>& out,
+                            std::size_t max_count = std::numeric_limits<std::size_t>::max()) {
+    const std::size_t n = std::min(max_count, to_issue_.size() - issued_);
+    for (std::size_t i = 0; i < n; ++i) out.push_back(point_of(to_issue_[issued_ + i]));
+    issued_ += n;
+    if (issued_ == to_issue_.size()) to_issue_.clear(), issued_ = 0;
+    return n;
+  }
+  // Requests not yet delivered (handed out or not).
+  [[nodiscard]] std::size_t outstanding_requests() const noexcept { return outstanding_; }
+
+  // Accepts the colours of requested vertices, in any order and any grouping. Errors: sizes
+  // differ; a vertex out of range, never requested, already delivered, or named twice; a
+  // non-finite colour (names the entry). On error nothing is stored.
+  // Complexity O(n + visible · level) (the shown set is brought up to date), plus
+  // O(V log V) when the cache bound evicts; allocation: the eviction's candidate list.
+  status deliver(std::span<const std::uint32_t> vertices, std::span<const glm::vec3> colours) {
+    if (vertices.size() != colours.size())
+      return make_error(errc::bad_size, no_element, "deliver: ", vertices.size(), " vertices but ", colours.size(), " colours");
+    std::size_t bad = no_index;
+    for (std::size_t i = 0; i < vertices.size() && bad == no_index; ++i) {
+      const std::uint32_t v = vertices[i];
+      if (v >= vstate_.size() || vstate_[v] != requested) bad = i;
+      else vstate_[v] = delivering;
+    }
+    for (std::size_t i = 0; i < vertices.size(); ++i)  // undo the marks (duplicates stay detectable above)
+      if (vertices[i] < vstate_.size() && vstate_[vertices[i]] == delivering) vstate_[vertices[i]] = requested;
+    if (bad != no_index) {
+      const std::uint32_t v = vertices[bad];
+      if (v >= vstate_.size())
+        return make_error(errc::index_out_of_range, bad, "deliver: entry ", bad, ": vertex ", v, " out of range (",
+                          vstate_.size(), " vertices)");
+      return make_error(errc::bad_parameter, bad, "deliver: entry ", bad, ": vertex ", v,
+                        vstate_[v] == shaded ? " was already delivered" : " has no outstanding request");
+    }
+    for (std::size_t i = 0; i < colours.size(); ++i)
+      if (!std::isfinite(colours[i].x) || !std::isfinite(colours[i].y) || !std::isfinite(colours[i].z))
+        return make_error(errc::non_finite, i, "deliver: entry ", i, ": colour of vertex ", vertices[i], " is not finite");
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const std::uint32_t v = vertices[i];
+      vstate_[v] = shaded;
+      colour_[v] = colours[i];
+      luminance_[v] = luminance(colours[i]);
+      delivered_epoch_[v] = delta_epoch_;
+    }
+    outstanding_ -= vertices.size();
+    samples_ += vertices.size();
+    shaded_count_ += vertices.size();
+    enforce_cache_bound();
+    update_display();
+    return {};
+  }
+
+  // Synchronous adaptor: hands out every outstanding request, shades it with
+  // glm::vec3 shade(const shading_point&) on the executor and delivers the results.
+  // Returns the number shaded. Allocation: the requests and colours.
+  template <class Shade, class E>
+  std::size_t shade_requests(Shade&& shade, E&& exec) {
+    static_assert(check_shade<Shade>());
+    static_assert(check_executor<std::remove_cvref_t<E>>());
+    std::vector<shading_point> points;
+    take_requests(points);
+    std::vector<std::uint32_t> ids(points.size());
+    std::vector<glm::vec3> colours(points.size());
+    exec.parallel_for(points.size(), 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        ids[i] = points[i].vertex;
+        colours[i] = shade(static_cast<const shading_point&>(points[i]));
+      }
+    });
+    [[maybe_unused]] const status st = deliver(ids, colours);
+    INFOLERP_ASSERT(st.ok() || points.empty());
+    return points.size();
+  }
+
+  // Interruptible refinement (§4.1): up to budget.batches batches of R selections in the
+  // current view, each split and followed by requests for the new visible vertices. A batch
+  // needs every earlier request delivered, so without a renderer behind the call (this
+  // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
+  // Preconditions: a view was set. Complexity per batch: the criterion's selection
+  // (criteria.hpp) + O(R) splits + O(pixels) re-location + O(visible · level).
+  template <class E>
+  refine_progress refine(E&& exec, refine_budget budget = {}) {
+    return refine_impl(exec, budget, [](auto&) {});
+  }
+  // As above with a synchronous renderer: each batch's requests are shaded at once, so the
+  // budget's batches, samples and seconds all apply.
+  template <class Shade, class E>
+  refine_progress refine(Shade&& shade, E&& exec, refine_budget budget = {}) {
+    static_assert(check_shade<Shade>());
+    return refine_impl(exec, budget, [&](E& ex) { shade_requests(shade, ex); });
+  }
+
+  // One batch of stage 2 with the synchronous renderer. Returns false when nothing was
+  // selected, the shading budget is reached, max_batches ran or the cache is full (then stage
+  // 2's figures are final). Preconditions: start() or set_view() succeeded.
   template <class Shade, class E>
   bool refine_batch(Shade&& shade, E&& exec) {
     if (done()) {
       report_.budget_reached = !finished_;
       return false;
     }
-    if (options_.criteria.criterion == refinement_criterion::nld_is) luminance_image(exec);
-    selected_.clear();
-    const refinement_frame f = frame();
-    select_for_refinement(f, options_.criteria, state_, selected_);
-    if (selected_.empty()) {
-      finished_ = true;
-      report_.stage2 = figures();
+    const refine_progress p = refine(shade, exec, refine_budget{.batches = 1});
+    if (p != refine_progress::refined) {
+      report_.budget_reached = p == refine_progress::cache_full;
       return false;
     }
-    for (std::uint32_t t : selected_) {
-      const status st = mesh_.split(t);
-      INFOLERP_ASSERT(st.ok());
-      (void)st;
-    }
-    ++report_.batches;
-    report_.selections += selected_.size();
-    relocate(exec);
-    shade_visible(shade, exec);
-    report_.stage2 = figures();
     if (done()) {
       report_.budget_reached = true;
       return false;
@@ -216,9 +343,36 @@ class progressive_refiner {
     return report_;
   }
 
-  // The current image: per pixel the shown leaf's vertex colours interpolated, or the
-  // background. Preconditions: image.size() == width·height, start() succeeded.
-  // O(pixels), no allocation.
+  // Moves the shown set forward and reports the change (§2's incremental protocol). Replaying
+  // every delta into a set reproduces shown_triangles(). O(shown); allocation: growth of out.
+  void take_delta(display_delta& out) {
+    out.clear();
+    std::size_t i = 0, j = 0;
+    while (i < sent_.size() || j < shown_.size()) {
+      if (j == shown_.size() || (i < sent_.size() && sent_[i] < shown_[j])) {
+        out.deleted.push_back(sent_[i++]);
+      } else if (i == sent_.size() || shown_[j] < sent_[i]) {
+        const std::uint32_t t = shown_[j++];
+        (newly_delivered(t) ? out.newly_shaded : out.added_from_cache).push_back(t);
+      } else {
+        ++i, ++j;
+      }
+    }
+    sent_ = shown_;
+    ++delta_epoch_;
+  }
+
+  // Bounds the cache (see the prologue). Errors: a bound of 0; then nothing changes.
+  status set_cache_bound(std::size_t max_cached_samples) {
+    if (max_cached_samples == 0) return make_error(errc::bad_parameter, no_element, "cache bound must be >= 1");
+    options_.max_cached_samples = max_cached_samples;
+    enforce_cache_bound();
+    return {};
+  }
+
+  // The current image: per pixel the colours of the shown triangle over it interpolated, or the
+  // background. Preconditions: image.size() == width·height, a view was set. O(pixels), no
+  // allocation.
   void reconstruct(std::span<glm::vec3> image) const {
     for (std::size_t p = 0; p < pixel_leaf_.size() && p < image.size(); ++p) image[p] = pixel_colour(p);
   }
@@ -228,9 +382,16 @@ class progressive_refiner {
   [[nodiscard]] std::span<const std::uint32_t> pixel_leaves() const noexcept { return pixel_leaf_; }
   [[nodiscard]] std::span<const std::uint32_t> visible_leaves() const noexcept { return visible_; }
   [[nodiscard]] std::span<const std::uint32_t> leaf_pixels() const noexcept { return leaf_pixels_; }
+  // The triangles the criterion selected in the last batch.
+  [[nodiscard]] std::span<const std::uint32_t> last_selection() const noexcept { return selected_; }
+  // The shown set (ascending): equals visible_leaves() once every request is delivered.
+  [[nodiscard]] std::span<const std::uint32_t> shown_triangles() const noexcept { return shown_; }
   // Shaded colour of a vertex (meaningful when vertex_shaded(v)).
   [[nodiscard]] glm::vec3 vertex_colour(std::size_t v) const { return colour_[v]; }
-  [[nodiscard]] bool vertex_shaded(std::size_t v) const { return v < shaded_.size() && shaded_[v] != 0; }
+  [[nodiscard]] bool vertex_shaded(std::size_t v) const { return v < vstate_.size() && vstate_[v] == shaded; }
+  // Shaded values held now, and samples delivered since start() (evicted ones shaded again count twice).
+  [[nodiscard]] std::size_t cached_samples() const noexcept { return shaded_count_; }
+  [[nodiscard]] std::size_t samples_delivered() const noexcept { return samples_; }
   // The frame the criteria see (pixel luminances filled only for NLD_IS).
   [[nodiscard]] refinement_frame frame() const {
     refinement_frame f;
@@ -243,21 +404,202 @@ class progressive_refiner {
     f.visible = visible_;
     f.vertex_luminance = luminance_;
     f.l_max = l_max_;
+    f.view_samples = view_requests_;
     return f;
   }
 
  private:
+  enum : std::uint8_t { unshaded = 0, requested = 1, shaded = 2, delivering = 3 };
+  static constexpr std::size_t no_index = std::numeric_limits<std::size_t>::max();
+
+  template <class Shade>
+  static constexpr bool check_shade() {
+    static_assert(std::is_invocable_r_v<glm::vec3, Shade&, const shading_point&>,
+                  "infolerp: shading callback needs `glm::vec3 shade(const infolerp::shading_point&)`");
+    return true;
+  }
+
+  template <class Camera>
+  static status check_camera(const Camera& camera) {
+    const std::uint32_t width = camera.width, height = camera.height;
+    if (std::size_t(width) * height == 0)
+      return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
+    if constexpr (requires { camera.eye; camera.target; camera.up; camera.vertical_fov_degrees; }) {
+      const glm::vec3 e = camera.eye, t = camera.target, u = camera.up;
+      for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(e[k]) || !std::isfinite(t[k]) || !std::isfinite(u[k]))
+          return make_error(errc::non_finite, no_element, "camera eye, target or up is not finite");
+      if (e == t) return make_error(errc::bad_parameter, no_element, "camera eye equals target: no view direction");
+      const glm::vec3 f = glm::normalize(t - e);
+      if (!(glm::length(glm::cross(f, u)) > 1e-6f * glm::length(u)))
+        return make_error(errc::bad_parameter, no_element, "camera up is zero or parallel to the view direction");
+      const float fov = camera.vertical_fov_degrees;
+      if (!(fov > 0.0f && fov < 180.0f))
+        return make_error(errc::bad_parameter, no_element, "camera vertical_fov_degrees ", fov, " outside (0, 180)");
+    }
+    return {};
+  }
+
+  // Traces and checks the view; only then (optionally) restarts and takes the view.
+  template <class T, class Camera, class E>
+  status view(const T& tracer, const Camera& camera, E&& exec, bool restart) {
+    const auto began = std::chrono::steady_clock::now();
+    std::vector<hit> hits;
+    if (auto st = trace_view(tracer, camera, exec, hits); !st) return st;
+    if (restart) reset();
+    apply_view(camera, hits, exec, began);
+    return {};
+  }
+
+  // Traces and checks a view without changing any state.
+  template <class T, class Camera, class E>
+  status trace_view(const T& tracer, const Camera& camera, E&& exec, std::vector<hit>& hits) const {
+    static_assert(check_tracer<T>());
+    static_assert(check_executor<std::remove_cvref_t<E>>());
+    if (auto st = check_camera(camera); !st) return st;
+    const std::uint32_t width = camera.width;
+    const std::size_t n = std::size_t(width) * camera.height;
+    hits.assign(n, hit{});
+    for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::vector<ray> rays(end - begin);
+      for (std::size_t p = begin; p < end; ++p)
+        rays[p - begin] = camera.primary_ray(static_cast<std::uint32_t>(p % width), static_cast<std::uint32_t>(p / width));
+      trace_intersect(tracer, std::span<const ray>(rays), std::span<hit>(hits.data() + begin, end - begin));
+    });
+    for (std::size_t p = 0; p < n; ++p) {
+      const hit& h = hits[p];
+      if (!h.valid()) continue;
+      if (h.triangle >= mesh_.original_triangle_count())
+        return make_error(errc::index_out_of_range, p, "pixel ", p, ": hit triangle ", h.triangle,
+                          " is not in the mesh (", mesh_.original_triangle_count(), " triangles)");
+      if (!std::isfinite(h.distance) || !std::isfinite(h.barycentric.x) || !std::isfinite(h.barycentric.y))
+        return make_error(errc::non_finite, p, "pixel ", p, ": hit on triangle ", h.triangle,
+                          " has a non-finite distance or barycentric");
+    }
+    return {};
+  }
+
+  void reset() {
+    mesh_ = initial_mesh_;
+    selected_.clear();
+    state_ = criterion_state{};
+    state_.rng = splitmix64{options_.criteria.seed};
+    pixel_luminance_.clear();
+    in_view_.clear();
+    ever_shown_.clear();
+    ever_shown_count_ = 0;
+    vstate_.clear();
+    colour_.clear();
+    luminance_.clear();
+    last_seen_.clear();
+    delivered_epoch_.clear();
+    to_issue_.clear();
+    issued_ = 0;
+    outstanding_ = 0;
+    shaded_count_ = 0;
+    in_view_vertices_ = 0;
+    samples_ = 0;
+    l_max_ = 0.0f;
+    clock_ = 0;
+    view_requests_ = 0;
+    delta_epoch_ = 0;
+    shown_.clear();
+    sent_.clear();
+  }
+
+  template <class Camera, class E>
+  void apply_view(const Camera& camera, const std::vector<hit>& hits, E&& exec,
+                  std::chrono::steady_clock::time_point began) {
+    started_ = began;
+    width_ = camera.width;
+    height_ = camera.height;
+    const std::size_t n = hits.size();
+    pixel_leaf_.assign(n, invalid_id);
+    pixel_weights_.assign(n, glm::vec3(0.0f));
+    for (std::size_t p = 0; p < n; ++p) {
+      if (!hits[p].valid()) continue;
+      pixel_leaf_[p] = hits[p].triangle;
+      const glm::vec2 b = hits[p].barycentric;
+      pixel_weights_[p] = glm::vec3(1.0f - b.x - b.y, b.x, b.y);
+    }
+    finished_ = false;
+    stage1_recorded_ = false;
+    view_requests_ = 0;
+    state_.points_drawn = 0;
+    state_.exhausted = false;
+    report_ = {};
+    update_view(exec);
+  }
+
   [[nodiscard]] bool done() const {
     return finished_ || report_.stage2.shading_samples >= options_.max_shading_samples ||
-           report_.batches >= options_.max_batches;
+           report_.batches >= options_.max_batches || cache_full();
+  }
+
+  void record_stage1() {
+    if (stage1_recorded_) return;
+    stage1_recorded_ = true;
+    report_.stage1 = figures();
+    report_.stage2 = report_.stage1;
+  }
+
+  template <class E, class Render>
+  refine_progress refine_impl(E& exec, refine_budget budget, Render&& render) {
+    const auto began = std::chrono::steady_clock::now();
+    const std::size_t samples_before = samples_ + outstanding_;
+    // Stops early return the reason unless a batch ran in this call (the next call reports it).
+    for (std::size_t b = 0; b < budget.batches; ++b) {
+      if (b > 0 && (samples_ + outstanding_ - samples_before >= budget.samples ||
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count() >= budget.seconds))
+        break;
+      if (outstanding_ > 0) return b == 0 ? refine_progress::waiting : refine_progress::refined;
+      record_stage1();
+      if (finished_) return b == 0 ? refine_progress::finished : refine_progress::refined;
+      if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
+      luminance_image(exec);  // also L_max
+      selected_.clear();
+      select_for_refinement(frame(), options_.criteria, state_, selected_);
+      if (selected_.empty()) {
+        finished_ = true;
+        report_.stage2 = figures();
+        return b == 0 ? refine_progress::finished : refine_progress::refined;
+      }
+      for (std::uint32_t t : selected_) {
+        [[maybe_unused]] const status st = mesh_.split(t);
+        INFOLERP_ASSERT(st.ok());
+      }
+      ++report_.batches;
+      report_.selections += selected_.size();
+      update_view(exec);
+      render(exec);
+      report_.stage2 = figures();
+    }
+    return refine_progress::refined;
   }
 
   [[nodiscard]] glm::vec3 pixel_colour(std::size_t p) const {
     const std::uint32_t leaf = pixel_leaf_[p];
     if (leaf == invalid_id) return options_.background;
-    const glm::uvec3 v = mesh_.triangle(leaf).vertices;
-    const glm::vec3 w = pixel_weights_[p];
+    const std::uint32_t d = display_of_[leaf];
+    if (d == invalid_id) return options_.background;
+    const glm::uvec3 v = mesh_.triangle(d).vertices;
+    const glm::vec3 w = d == leaf ? pixel_weights_[p] : weights_in(d, leaf, pixel_weights_[p]);
     return w.x * colour_[v.x] + w.y * colour_[v.y] + w.z * colour_[v.z];
+  }
+  // The barycentric weights in ancestor a of the point with weights w in leaf l (planar).
+  [[nodiscard]] glm::vec3 weights_in(std::uint32_t a, std::uint32_t l, glm::vec3 w) const {
+    const glm::uvec3 lv = mesh_.triangle(l).vertices, av = mesh_.triangle(a).vertices;
+    const glm::dvec3 p = double(w.x) * glm::dvec3(mesh_.position(lv.x)) + double(w.y) * glm::dvec3(mesh_.position(lv.y)) +
+                         double(w.z) * glm::dvec3(mesh_.position(lv.z));
+    const glm::dvec3 b = barycentric(av, p);
+    return glm::vec3(b);
+  }
+  [[nodiscard]] glm::dvec3 barycentric(glm::uvec3 t, glm::dvec3 p) const {
+    const glm::dvec3 a(mesh_.position(t.x)), b(mesh_.position(t.y)), c(mesh_.position(t.z));
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double nn = glm::dot(n, n);
+    const double u = glm::dot(glm::cross(p - a, c - a), n) / nn, v = glm::dot(glm::cross(b - a, p - a), n) / nn;
+    return {1.0 - u - v, u, v};
   }
 
   [[nodiscard]] stage_figures figures() const {
@@ -270,9 +612,10 @@ class progressive_refiner {
     return s;
   }
 
-  // Pixels whose leaf was split follow it down; projected areas and the visible set are rebuilt.
+  // Pixels whose leaf was split follow it down; projected areas, the visible set, the in-view
+  // marks, the requests and the shown set are brought up to date.
   template <class E>
-  void relocate(E&& exec) {
+  void update_view(E&& exec) {
     const std::size_t n = pixel_leaf_.size();
     exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) {
@@ -283,38 +626,95 @@ class progressive_refiner {
         pixel_weights_[p] = loc.weights;
       }
     });
-    leaf_pixels_.assign(mesh_.triangle_count(), 0);
-    ever_shown_.resize(mesh_.triangle_count(), 0);
+    const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
+    leaf_pixels_.assign(nt, 0);
+    ever_shown_.resize(nt, 0);
+    in_view_.resize(nt, 0);
+    display_of_.resize(nt, invalid_id);
+    vstate_.resize(nv, unshaded);
+    colour_.resize(nv, glm::vec3(0.0f));
+    luminance_.resize(nv, 0.0f);
+    last_seen_.resize(nv, 0);
+    delivered_epoch_.resize(nv, 0);
     visible_.clear();
     for (std::uint32_t leaf : pixel_leaf_)
       if (leaf != invalid_id && leaf_pixels_[leaf]++ == 0) visible_.push_back(leaf);
     std::sort(visible_.begin(), visible_.end());
     for (std::uint32_t t : visible_)
       if (!ever_shown_[t]) ever_shown_[t] = 1, ++ever_shown_count_;
+    // In view: the visible leaves and their ancestors; their corners are stamped and requested.
+    ++clock_;
+    in_view_vertices_ = 0;
+    for (std::uint32_t leaf : visible_)
+      for (std::uint32_t t = leaf; t != invalid_id && in_view_[t] != clock_; t = mesh_.triangle(t).parent) {
+        in_view_[t] = clock_;
+        const glm::uvec3 v = mesh_.triangle(t).vertices;
+        for (int c = 0; c < 3; ++c) {
+          if (last_seen_[v[c]] != clock_) ++in_view_vertices_;
+          last_seen_[v[c]] = clock_;
+          if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_, ++view_requests_;
+        }
+      }
+    enforce_cache_bound();
+    update_display();
   }
 
-  // The vertex shading cache: every vertex of a visible leaf is shaded exactly once.
-  template <class Shade, class E>
-  void shade_visible(Shade& shade, E&& exec) {
-    const std::size_t nv = mesh_.vertex_count();
-    shaded_.resize(nv, 0);
-    colour_.resize(nv, glm::vec3(0.0f));
-    luminance_.resize(nv, 0.0f);
-    pending_.clear();
-    for (std::uint32_t t : visible_) {
-      const glm::uvec3 v = mesh_.triangle(t).vertices;
-      for (int c = 0; c < 3; ++c)
-        if (!shaded_[v[c]]) shaded_[v[c]] = 1, pending_.push_back(v[c]);
-    }
-    exec.parallel_for(pending_.size(), 256, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t v = pending_[i];
-        colour_[v] = shade(point_of(v));
-        luminance_[v] = luminance(colour_[v]);
+  // The current view alone fills the cache: nothing is left to evict.
+  [[nodiscard]] bool cache_full() const noexcept { return in_view_vertices_ >= options_.max_cached_samples; }
+
+  [[nodiscard]] bool ready(std::uint32_t t) const {
+    const glm::uvec3 v = mesh_.triangle(t).vertices;
+    return vstate_[v.x] == shaded && vstate_[v.y] == shaded && vstate_[v.z] == shaded;
+  }
+  // A shown split triangle gives way to its children once every child in view is ready.
+  [[nodiscard]] bool expands(std::uint32_t t) const {
+    const subdivision_triangle& n = mesh_.triangle(t);
+    for (std::uint32_t c = n.first_child; c < n.first_child + n.child_count; ++c)
+      if (in_view_[c] == clock_ && !ready(c)) return false;
+    return true;
+  }
+  [[nodiscard]] bool newly_delivered(std::uint32_t t) const {
+    const glm::uvec3 v = mesh_.triangle(t).vertices;
+    return delivered_epoch_[v.x] == delta_epoch_ || delivered_epoch_[v.y] == delta_epoch_ ||
+           delivered_epoch_[v.z] == delta_epoch_;
+  }
+
+  // The shown set: for each visible leaf, walk down from its root while triangles are ready and
+  // expand (the cut described in the prologue).
+  void update_display() {
+    shown_.clear();
+    for (std::uint32_t leaf : visible_) {
+      path_.clear();
+      for (std::uint32_t t = leaf; t != invalid_id; t = mesh_.triangle(t).parent) path_.push_back(t);
+      std::uint32_t d = invalid_id;
+      for (auto it = path_.rbegin(); it != path_.rend(); ++it) {
+        if (!ready(*it)) break;
+        d = *it;
+        if (*it == leaf || !expands(*it)) break;
       }
-    });
-    for (std::uint32_t v : pending_) l_max_ = std::max(l_max_, luminance_[v]);
-    samples_ += pending_.size();
+      display_of_[leaf] = d;
+      if (d != invalid_id) shown_.push_back(d);
+    }
+    std::sort(shown_.begin(), shown_.end());
+    shown_.erase(std::unique(shown_.begin(), shown_.end()), shown_.end());
+  }
+
+  // Least recently visible first (ties by id), never a vertex of the current view.
+  void enforce_cache_bound() {
+    if (shaded_count_ <= options_.max_cached_samples) return;
+    evict_.clear();
+    for (std::uint32_t v = 0; v < vstate_.size(); ++v)
+      if (vstate_[v] == shaded && last_seen_[v] != clock_) evict_.push_back(v);
+    const std::size_t excess = std::min(shaded_count_ - options_.max_cached_samples, evict_.size());
+    std::partial_sort(evict_.begin(), evict_.begin() + std::ptrdiff_t(excess), evict_.end(),
+                      [&](std::uint32_t a, std::uint32_t b) { return last_seen_[a] != last_seen_[b] ? last_seen_[a] < last_seen_[b] : a < b; });
+    for (std::size_t i = 0; i < excess; ++i) {
+      const std::uint32_t v = evict_[i];
+      vstate_[v] = unshaded;
+      colour_[v] = glm::vec3(0.0f);
+      luminance_[v] = 0.0f;
+    }
+    shaded_count_ -= excess;
   }
 
   [[nodiscard]] shading_point point_of(std::uint32_t v) const {
@@ -323,23 +723,25 @@ class progressive_refiner {
     sp.position = mesh_.position(v);
     sp.triangle = mesh_.vertex_source(v);
     const glm::uvec3 o = mesh_.triangle(sp.triangle).vertices;  // original triangles keep their ids
-    const glm::dvec3 a(mesh_.position(o.x)), b(mesh_.position(o.y)), c(mesh_.position(o.z)), p(sp.position);
-    const glm::dvec3 n = glm::cross(b - a, c - a);
-    const double nn = glm::dot(n, n);
-    sp.barycentric = glm::vec2(static_cast<float>(glm::dot(glm::cross(p - a, c - a), n) / nn),
-                               static_cast<float>(glm::dot(glm::cross(b - a, p - a), n) / nn));
+    const glm::dvec3 a(mesh_.position(o.x)), b(mesh_.position(o.y)), c(mesh_.position(o.z));
+    sp.normal = glm::vec3(glm::normalize(glm::cross(b - a, c - a)));
+    const glm::dvec3 w = barycentric(o, glm::dvec3(sp.position));
+    sp.barycentric = glm::vec2(static_cast<float>(w.y), static_cast<float>(w.z));
     return sp;
   }
 
+  // The interpolated luminance per pixel and L_max, its maximum over the image (§4).
   template <class E>
   void luminance_image(E&& exec) {
     pixel_luminance_.resize(pixel_leaf_.size());
     exec.parallel_for(pixel_leaf_.size(), options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) pixel_luminance_[p] = luminance(pixel_colour(p));
     });
+    l_max_ = 0.0f;
+    for (float l : pixel_luminance_) l_max_ = std::max(l_max_, l);
   }
 
-  subdivision_mesh mesh_;
+  subdivision_mesh initial_mesh_, mesh_;
   driver_options options_;
   criterion_state state_;
   std::uint32_t width_ = 0, height_ = 0;
@@ -348,16 +750,27 @@ class progressive_refiner {
   std::vector<float> pixel_luminance_;
   std::vector<std::uint32_t> leaf_pixels_;
   std::vector<std::uint32_t> visible_;
+  std::vector<std::uint32_t> in_view_;     // per triangle: clock_ when it or a descendant is visible
+  std::vector<std::uint32_t> display_of_;  // per visible leaf: the shown triangle over it
   std::vector<std::uint8_t> ever_shown_;
   std::size_t ever_shown_count_ = 0;
-  std::vector<std::uint8_t> shaded_;
+  std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
   std::vector<float> luminance_;
-  std::vector<std::uint32_t> pending_;
+  std::vector<std::uint32_t> last_seen_;        // per vertex: clock_ when last in view
+  std::vector<std::uint32_t> delivered_epoch_;  // per vertex: delta_epoch_ of its delivery
+  std::vector<std::uint32_t> to_issue_;
+  std::size_t issued_ = 0;
+  std::size_t outstanding_ = 0;
+  std::size_t shaded_count_ = 0;
+  std::size_t in_view_vertices_ = 0;  // vertices stamped with the current clock_
+  std::size_t view_requests_ = 0;     // requests issued since the view was set
+  std::vector<std::uint32_t> shown_, sent_, path_, evict_;
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
   std::size_t samples_ = 0;
-  bool finished_ = false;
+  std::uint32_t clock_ = 0, delta_epoch_ = 0;
+  bool finished_ = false, stage1_recorded_ = false;
   refinement_report report_;
   std::chrono::steady_clock::time_point started_{};
 };

@@ -168,21 +168,53 @@ class edge_table {
 // §4.1 of the clustering paper: "tessellate these polygons until they had a ratio of polygon
 // area to on-screen-projected area below a user-provided threshold". A triangle's own
 // area/projected-area ratio does not change under 1:4 splitting, so we read the ratio as the
-// triangle's projected area over the screen's area: split while it exceeds `max_fraction`.
-// Triangles with a corner at or behind the eye plane (w <= 0) always count as too large
-// (tessellate's max_level bounds them).
+// triangle's on-screen area over the screen's area: split while it exceeds `max_fraction`.
+// On-screen area: the triangle clipped in homogeneous clip space against the six planes of the
+// view volume (-w <= x, y, z <= w, OpenGL depth; Sutherland–Hodgman), the clipped polygon's
+// corners divided by w, its area taken in NDC. So a triangle behind the eye or outside the
+// frustum has area 0 and is never split, and one crossing the eye plane counts only its part
+// in front of the near plane. O(1) (at most 9 polygon corners), no allocation.
 struct screen_fraction_test {
   glm::mat4 view_projection{1.0f};  // world to clip space
   float max_fraction = 0.01f;       // largest share of the screen a triangle may cover
-  bool operator()(glm::vec3 a, glm::vec3 b, glm::vec3 c) const {
-    const glm::vec4 ca = view_projection * glm::vec4(a, 1.0f), cb = view_projection * glm::vec4(b, 1.0f),
-                    cc = view_projection * glm::vec4(c, 1.0f);
-    if (!(ca.w > 0.0f && cb.w > 0.0f && cc.w > 0.0f)) return true;
-    const glm::vec2 pa = glm::vec2(ca) / ca.w, pb = glm::vec2(cb) / cb.w, pc = glm::vec2(cc) / cc.w;
-    const glm::vec2 e1 = pb - pa, e2 = pc - pa;
-    const float ndc_area = 0.5f * std::abs(e1.x * e2.y - e1.y * e2.x);
-    return ndc_area / 4.0f > max_fraction;  // the screen spans [-1,1]², area 4
+
+  // The share of the screen [-1,1]² the triangle covers, in [0, 1] for a triangle that does not
+  // overlap itself in projection; 0 when nothing of it lies in the view volume.
+  [[nodiscard]] float screen_fraction(glm::vec3 a, glm::vec3 b, glm::vec3 c) const {
+    glm::vec4 poly[9], next[9];
+    poly[0] = view_projection * glm::vec4(a, 1.0f);
+    poly[1] = view_projection * glm::vec4(b, 1.0f);
+    poly[2] = view_projection * glm::vec4(c, 1.0f);
+    int n = 3;
+    for (int plane = 0; plane < 6 && n > 0; ++plane) {
+      const int axis = plane / 2;
+      const float sign = (plane % 2) ? -1.0f : 1.0f;
+      auto distance = [&](const glm::vec4& p) { return p.w + sign * p[axis]; };  // >= 0 inside
+      int m = 0;
+      for (int i = 0; i < n; ++i) {
+        const glm::vec4& p = poly[i];
+        const glm::vec4& q = poly[(i + 1) % n];
+        const float dp = distance(p), dq = distance(q);
+        if (dp >= 0.0f) next[m++] = p;
+        if ((dp >= 0.0f) != (dq >= 0.0f)) next[m++] = p + (dp / (dp - dq)) * (q - p);
+      }
+      n = m;
+      std::copy(next, next + m, poly);
+    }
+    if (n < 3) return 0.0f;
+    double twice_area = 0.0;
+    glm::dvec2 first{0.0}, prev{0.0};
+    for (int i = 0; i < n; ++i) {
+      if (!(poly[i].w > 0.0f)) return 0.0f;  // only the eye point itself: nothing on screen
+      const glm::dvec2 p = glm::dvec2(poly[i].x, poly[i].y) / double(poly[i].w);
+      if (i == 0) first = p;
+      else twice_area += prev.x * p.y - prev.y * p.x;
+      prev = p;
+    }
+    twice_area += prev.x * first.y - prev.y * first.x;
+    return static_cast<float>(std::abs(twice_area) / 8.0);  // the screen spans [-1,1]², area 4
   }
+  bool operator()(glm::vec3 a, glm::vec3 b, glm::vec3 c) const { return screen_fraction(a, b, c) > max_fraction; }
 };
 
 // Not thread-safe for modification (split, tessellate); const members may be called

@@ -1,0 +1,364 @@
+// refine/progressive_driver.hpp as a walkthrough agent over the Embree walkthrough scene: views
+// that change with the cache kept, asynchronous delivery in any order, the incremental protocol
+// replayed into a plain set, restarts, the cache bound, and bad input.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <mutex>
+#include <random>
+#include <set>
+#include <thread>
+#include <vector>
+#include <glm/geometric.hpp>
+#include "infolerp/refine/progressive_driver.hpp"
+#include "support/thread_pool.hpp"
+#include "support/walkthrough_scene.hpp"
+
+using namespace infolerp;  // NOLINT: test file
+
+namespace {
+
+constexpr std::uint32_t W = 64, H = 48, FRAMES = 12;
+
+const support::walkthrough_scene& scene() {
+  static auto s = support::make_walkthrough_scene();
+  REQUIRE(s.ok());
+  return *s;
+}
+
+progressive_refiner make_agent(driver_options o = {}) {
+  auto s = subdivision_mesh::build(scene().mesh);
+  REQUIRE(s.ok());
+  o.criteria.min_pixels = 6.0f;
+  auto r = progressive_refiner::create(std::move(*s), o);
+  REQUIRE(r.ok());
+  return std::move(*r);
+}
+
+auto shader() {
+  return [](const shading_point& sp) { return scene().shade(sp.position, sp.triangle); };
+}
+
+std::vector<glm::vec3> image_of(const progressive_refiner& r) {
+  std::vector<glm::vec3> img(std::size_t(W) * H);
+  r.reconstruct(img);
+  return img;
+}
+
+bool same_bits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+}
+
+// Per frame of the walk: the image after refinement finished, and the samples delivered so far.
+struct walk_record {
+  std::vector<std::vector<glm::vec3>> images;
+  std::vector<std::size_t> samples;
+};
+
+// The synchronous walk: set_view, then refine until the criterion stops.
+template <class E>
+walk_record walk_sync(progressive_refiner& r, E&& exec) {
+  walk_record out;
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    REQUIRE(r.set_view(scene(), support::walkthrough_path(f, FRAMES, W, H), exec).ok());
+    r.shade_requests(shader(), exec);
+    while (r.refine(shader(), exec, {.batches = 4}) == refine_progress::refined) {
+    }
+    out.images.push_back(image_of(r));
+    out.samples.push_back(r.samples_delivered());
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("walkthrough: asynchronous delivery in any order, the delta replay and executors agree") {
+  auto sync = make_agent();
+  const walk_record reference = walk_sync(sync, serial_executor{});
+  REQUIRE(reference.samples.back() > 0);
+
+  auto r = make_agent();
+  support::thread_pool_executor pool{3};
+  std::mt19937 rng(11);
+  std::set<std::uint32_t> replay;  // the visualizer: a plain set fed only by deltas
+  display_delta delta;
+  std::size_t deltas = 0, from_cache = 0;
+  auto apply_delta = [&] {
+    r.take_delta(delta);
+    ++deltas;
+    from_cache += delta.added_from_cache.size();
+    for (std::uint32_t t : delta.added_from_cache) CHECK(replay.insert(t).second);
+    for (std::uint32_t t : delta.deleted) CHECK(replay.erase(t) == 1);
+    for (std::uint32_t t : delta.newly_shaded) CHECK(replay.insert(t).second);
+    const auto shown = r.shown_triangles();
+    REQUIRE(std::equal(replay.begin(), replay.end(), shown.begin(), shown.end()));
+    for (std::uint32_t t : shown) {  // what is shown has every corner shaded
+      const glm::uvec3 v = r.mesh().triangle(t).vertices;
+      REQUIRE((r.vertex_shaded(v.x) && r.vertex_shaded(v.y) && r.vertex_shaded(v.z)));
+    }
+  };
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    REQUIRE(r.set_view(scene(), support::walkthrough_path(f, FRAMES, W, H), pool).ok());
+    apply_delta();
+    for (;;) {
+      // Shade the requests on worker threads, deliver them shuffled, in uneven chunks, each
+      // delivery from whichever thread finishes (serialised by a mutex), a delta after each.
+      std::vector<shading_point> req;
+      r.take_requests(req);
+      std::shuffle(req.begin(), req.end(), rng);
+      std::mutex m;
+      std::vector<std::thread> workers;
+      const std::size_t chunks = 1 + req.size() / 17;
+      for (std::size_t c = 0; c < chunks; ++c)
+        workers.emplace_back([&, c] {
+          std::vector<std::uint32_t> ids;
+          std::vector<glm::vec3> colours;
+          for (std::size_t i = c; i < req.size(); i += chunks) {
+            ids.push_back(req[i].vertex);
+            colours.push_back(shader()(req[i]));
+          }
+          const std::lock_guard<std::mutex> lock(m);
+          REQUIRE(r.deliver(ids, colours).ok());
+          apply_delta();
+        });
+      for (auto& w : workers) w.join();
+      if (r.refine(pool) != refine_progress::refined) break;
+      apply_delta();
+    }
+    REQUIRE(r.outstanding_requests() == 0);
+    // Everything delivered: the shown set is the visible leaf set.
+    const auto shown = r.shown_triangles(), visible = r.visible_leaves();
+    CHECK(std::equal(shown.begin(), shown.end(), visible.begin(), visible.end()));
+    INFO("frame " << f);
+    CHECK(same_bits(image_of(r), reference.images[f]));
+    CHECK(r.samples_delivered() == reference.samples[f]);
+  }
+  CHECK(deltas > 3 * FRAMES);
+  CHECK(from_cache > 0);  // the way back re-uses cached triangles
+
+  auto pooled = make_agent();
+  const walk_record parallel = walk_sync(pooled, support::thread_pool_executor{4});
+  for (std::uint32_t f = 0; f < FRAMES; ++f) CHECK(same_bits(parallel.images[f], reference.images[f]));
+  CHECK(parallel.samples == reference.samples);
+}
+
+TEST_CASE("walkthrough: revisiting a view shades nothing new") {
+  auto r = make_agent();
+  serial_executor ex;
+  const pinhole_camera street = support::walkthrough_camera(support::walkthrough_view::street, W, H);
+  const pinhole_camera temple = support::walkthrough_camera(support::walkthrough_view::temple, W, H);
+  REQUIRE(r.run(scene(), street, shader(), ex).ok());
+  const auto first = image_of(r);
+  const std::size_t after_first = r.samples_delivered();
+  // The same view again: no request, nothing to refine, the same image.
+  REQUIRE(r.set_view(scene(), street, ex).ok());
+  CHECK(r.outstanding_requests() == 0);
+  CHECK(r.refine(shader(), ex) == refine_progress::finished);
+  CHECK(r.samples_delivered() == after_first);
+  // Same colours; pixel weights are located afresh from the root (not followed batch by batch),
+  // so they may differ in the last float bits.
+  const auto again = image_of(r);
+  float diff = 0.0f;
+  for (std::size_t i = 0; i < again.size(); ++i) diff = std::max(diff, glm::length(again[i] - first[i]));
+  CHECK(diff < 1e-5f);
+  // Away to the temple and back: the hierarchy the temple refined is shared, so the street's
+  // leaves can be finer now; the few corners no view shaded yet are all that is asked for.
+  REQUIRE(r.set_view(scene(), temple, ex).ok());
+  r.shade_requests(shader(), ex);
+  while (r.refine(shader(), ex, {.batches = 8}) == refine_progress::refined) {
+  }
+  const std::size_t after_temple = r.samples_delivered();
+  REQUIRE(r.set_view(scene(), street, ex).ok());
+  r.shade_requests(shader(), ex);
+  while (r.refine(shader(), ex, {.batches = 8}) == refine_progress::refined) {
+  }
+  INFO("street " << after_first << ", temple +" << after_temple - after_first << ", street again +"
+                 << r.samples_delivered() - after_temple);
+  CHECK(r.samples_delivered() - after_temple < after_first / 10);
+}
+
+TEST_CASE("walkthrough: only visible triangles are selected, and a view change is honoured at once") {
+  auto r = make_agent({.criteria = {.batch = 4}});
+  serial_executor ex;
+  std::size_t batches = 0;
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    const pinhole_camera cam = support::walkthrough_path(f, FRAMES, W, H);
+    REQUIRE(r.set_view(scene(), cam, ex).ok());
+    r.shade_requests(shader(), ex);
+    // Two batches per frame at most (an engine calling once per frame), then the view moves on.
+    for (int b = 0; b < 2 && r.refine(shader(), ex) == refine_progress::refined; ++b) {
+      ++batches;
+      const glm::vec3 fwd = glm::normalize(cam.target - cam.eye);
+      for (std::uint32_t t : r.last_selection()) {
+        const glm::uvec3 v = r.mesh().triangle(t).vertices;
+        bool in_front = false;
+        for (int c = 0; c < 3; ++c) in_front = in_front || glm::dot(r.mesh().position(v[c]) - cam.eye, fwd) > 0.0f;
+        CHECK(in_front);  // never a triangle behind the eye
+        CHECK(r.leaf_pixels()[t] == 0);  // split now; it was a visible leaf of this view when selected
+        CHECK(!r.mesh().is_leaf(t));
+      }
+    }
+  }
+  CHECK(batches > FRAMES);
+  // Budgets: a zero time budget or a one-sample budget still runs exactly one batch.
+  auto a = make_agent({.criteria = {.batch = 2}});
+  REQUIRE(a.start(scene(), support::walkthrough_camera(W, H), shader(), ex).ok());
+  CHECK(a.refine(shader(), ex, {.batches = 1000, .seconds = 0.0}) == refine_progress::refined);
+  CHECK(a.report().batches == 1);
+  CHECK(a.refine(shader(), ex, {.batches = 1000, .samples = 1}) == refine_progress::refined);
+  CHECK(a.report().batches == 2);
+  // Without a renderer the second batch waits for the first one's deliveries.
+  CHECK(a.refine(ex, {.batches = 5}) == refine_progress::refined);
+  CHECK(a.report().batches == 3);
+  CHECK(a.outstanding_requests() > 0);
+  CHECK(a.refine(ex) == refine_progress::waiting);
+}
+
+TEST_CASE("walkthrough: start() after a finished run is a full restart") {
+  serial_executor ex;
+  const pinhole_camera street = support::walkthrough_camera(support::walkthrough_view::street, W, H);
+  const pinhole_camera wall = support::walkthrough_camera(support::walkthrough_view::wall, W, H);
+  auto fresh = make_agent();
+  auto fresh_rep = fresh.run(scene(), wall, shader(), ex);
+  REQUIRE(fresh_rep.ok());
+  auto r = make_agent();
+  REQUIRE(r.run(scene(), street, shader(), ex).ok());
+  auto rep = r.run(scene(), wall, shader(), ex);
+  REQUIRE(rep.ok());
+  CHECK(rep->batches == fresh_rep->batches);
+  CHECK(rep->batches > 0);
+  CHECK(rep->stage1.shading_samples == fresh_rep->stage1.shading_samples);
+  CHECK(rep->stage2.shading_samples == fresh_rep->stage2.shading_samples);
+  CHECK(rep->stage2.triangles_total == fresh_rep->stage2.triangles_total);
+  CHECK(r.mesh().triangle_count() == fresh.mesh().triangle_count());
+  CHECK(same_bits(image_of(r), image_of(fresh)));
+}
+
+TEST_CASE("walkthrough: the cache bound is honoured and changes no image") {
+  serial_executor ex;
+  auto unbounded = make_agent();
+  const walk_record reference = walk_sync(unbounded, ex);
+  // A bound a little above what the busiest single view needs.
+  std::size_t per_view = 0;
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    auto one = make_agent();
+    REQUIRE(one.run(scene(), support::walkthrough_path(f, FRAMES, W, H), shader(), ex).ok());
+    per_view = std::max(per_view, one.cached_samples());
+  }
+  const std::size_t bound = per_view + per_view / 4;
+  REQUIRE(bound < unbounded.cached_samples());  // the bound bites
+  auto r = make_agent({.max_cached_samples = bound});
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    REQUIRE(r.set_view(scene(), support::walkthrough_path(f, FRAMES, W, H), ex).ok());
+    r.shade_requests(shader(), ex);
+    CHECK(r.cached_samples() <= bound);
+    refine_progress p;
+    while ((p = r.refine(shader(), ex)) == refine_progress::refined) CHECK(r.cached_samples() <= bound);
+    CHECK(p == refine_progress::finished);  // the bound never stopped refinement here
+    INFO("frame " << f);
+    CHECK(same_bits(image_of(r), reference.images[f]));
+  }
+  CHECK(r.samples_delivered() > reference.samples.back());  // evicted samples were shaded again
+}
+
+TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
+  serial_executor ex;
+  auto r = make_agent();
+  const pinhole_camera street = support::walkthrough_camera(W, H);
+  REQUIRE(r.start(scene(), street, shader(), ex).ok());
+  REQUIRE(r.refine(ex) == refine_progress::refined);  // leaves requests outstanding
+  std::vector<shading_point> req;
+  r.take_requests(req, 3);
+  REQUIRE(req.size() == 3);
+  const auto image = image_of(r);
+  const std::size_t outstanding = r.outstanding_requests(), cached = r.cached_samples();
+  const std::vector<std::uint32_t> shown(r.shown_triangles().begin(), r.shown_triangles().end());
+  auto unchanged = [&] {
+    CHECK(same_bits(image_of(r), image));
+    CHECK(r.outstanding_requests() == outstanding);
+    CHECK(r.cached_samples() == cached);
+    CHECK(std::equal(shown.begin(), shown.end(), r.shown_triangles().begin(), r.shown_triangles().end()));
+  };
+  // Degenerate and NaN cameras.
+  pinhole_camera bad = street;
+  bad.target = bad.eye;
+  CHECK(r.set_view(scene(), bad, ex).code() == errc::bad_parameter);
+  bad = street;
+  bad.up = glm::normalize(street.target - street.eye);
+  CHECK(r.set_view(scene(), bad, ex).code() == errc::bad_parameter);
+  bad = street;
+  bad.eye.y = std::numeric_limits<float>::quiet_NaN();
+  CHECK(r.set_view(scene(), bad, ex).code() == errc::non_finite);
+  bad = street;
+  bad.vertical_fov_degrees = 180.0f;
+  CHECK(r.set_view(scene(), bad, ex).code() == errc::bad_parameter);
+  bad = street;
+  bad.width = 0;
+  CHECK(r.set_view(scene(), bad, ex).code() == errc::empty_input);
+  CHECK(r.start(scene(), bad, shader(), ex).code() == errc::empty_input);
+  unchanged();
+  // Deliveries: unknown vertex, out of range, named twice in one call, a NaN colour.
+  std::uint32_t never = 0;
+  while (never < r.mesh().vertex_count() && (r.vertex_shaded(never) || std::any_of(req.begin(), req.end(), [&](const shading_point& s) { return s.vertex == never; })))
+    ++never;
+  std::vector<std::uint32_t> ids = {req[0].vertex, never};
+  std::vector<glm::vec3> colours(2, glm::vec3(0.5f));
+  const status unknown = r.deliver(ids, colours);
+  CHECK(unknown.code() == errc::bad_parameter);
+  CHECK(unknown.element() == 1);
+  ids = {req[0].vertex, static_cast<std::uint32_t>(r.mesh().vertex_count())};
+  CHECK(r.deliver(ids, colours).code() == errc::index_out_of_range);
+  ids = {req[1].vertex, req[1].vertex};
+  CHECK(r.deliver(ids, colours).code() == errc::bad_parameter);
+  ids = {req[0].vertex, req[1].vertex};
+  colours[1].y = std::numeric_limits<float>::quiet_NaN();
+  CHECK(r.deliver(ids, colours).code() == errc::non_finite);
+  CHECK(r.deliver(ids, std::vector<glm::vec3>(1)).code() == errc::bad_size);
+  unchanged();
+  // Delivered twice.
+  ids = {req[2].vertex};
+  REQUIRE(r.deliver(ids, std::vector<glm::vec3>{glm::vec3(0.25f)}).ok());
+  CHECK(r.outstanding_requests() == outstanding - 1);
+  const status twice = r.deliver(ids, std::vector<glm::vec3>{glm::vec3(0.25f)});
+  CHECK(twice.code() == errc::bad_parameter);
+  CHECK(r.outstanding_requests() == outstanding - 1);
+  // A cache bound of zero.
+  CHECK(r.set_cache_bound(0).code() == errc::bad_parameter);
+  auto s = subdivision_mesh::build(scene().mesh);
+  REQUIRE(s.ok());
+  CHECK(progressive_refiner::create(std::move(*s), {.max_cached_samples = 0}).error().code() == errc::bad_parameter);
+}
+
+TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS stops at its pixel fraction") {
+  serial_executor ex;
+  auto r = make_agent();
+  const pinhole_camera street = support::walkthrough_camera(support::walkthrough_view::street, W, H);
+  for (const pinhole_camera& cam : {street, support::walkthrough_camera(support::walkthrough_view::wall, W, H)}) {
+    REQUIRE(r.set_view(scene(), cam, ex).ok());
+    r.shade_requests(shader(), ex);
+    const auto before = image_of(r);
+    float l_max = 0.0f;
+    for (const glm::vec3& c : before) l_max = std::max(l_max, luminance(c));
+    REQUIRE(r.refine(ex) == refine_progress::refined);  // L_max taken from `before`, then the split
+    CHECK(r.frame().l_max == l_max);
+    r.shade_requests(shader(), ex);
+  }
+  // NLD_IS: without a fraction it runs to its own end; with 2% of the pixels it stops there.
+  const std::size_t pixels = std::size_t(W) * H;
+  auto free_run = make_agent({.criteria = {.criterion = refinement_criterion::nld_is, .batch = 4}});
+  auto limited = make_agent({.criteria = {.criterion = refinement_criterion::nld_is, .batch = 4, .nld_is_pixel_fraction = 0.02f}});
+  auto a = free_run.run(scene(), street, shader(), ex);
+  auto b = limited.run(scene(), street, shader(), ex);
+  REQUIRE((a.ok() && b.ok()));
+  const double cap = 0.02 * double(pixels);
+  INFO("free " << a->stage2.shading_samples << ", limited " << b->stage2.shading_samples << ", cap " << cap);
+  CHECK(double(a->stage2.shading_samples) > cap + 4 * 12);
+  CHECK(double(b->stage2.shading_samples) >= cap);
+  CHECK(double(b->stage2.shading_samples) <= cap + 4 * 12);  // one batch of R = 4 may overshoot (<= 12 vertices each)
+  CHECK(!b->budget_reached);  // the criterion's own rule ended it
+  auto bad = subdivision_mesh::build(scene().mesh);
+  REQUIRE(bad.ok());
+  CHECK(progressive_refiner::create(std::move(*bad), {.criteria = {.nld_is_pixel_fraction = -1.0f}}).error().code() ==
+        errc::bad_parameter);
+}
