@@ -238,17 +238,25 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   REQUIRE(lod.ok());
   std::vector<std::uint32_t> out(contracted_index_bound(*h));
   std::vector<index_range> ranges(8);
-  for (std::uint64_t r : {std::uint64_t{0}, std::uint64_t{100}, lod->capacity() / 2, lod->capacity()}) {
+  REQUIRE(h->local_contractions > 100);
+  REQUIRE(h->local_contractions < h->contraction_count());
+  for (std::uint64_t r : {std::uint64_t{0}, std::uint64_t{100}, std::uint64_t{h->local_contractions}, lod->capacity() / 2,
+                          lod->capacity() - 3, lod->capacity()}) {
     auto st = lod->frame(glm::dvec3(0.3, -2.0, 4.0), r, out, ranges);
     REQUIRE(st.ok());
-    CHECK(st->budgeted == r);  // eq. 9 spends exactly R_global when it fits the capacity
-    CHECK(st->applied >= r);
+    CHECK(st->budgeted == r);  // eq. 9 spends exactly R_global
+    CHECK(st->applied == r);   // and the local phase needs no matching: budgets honoured exactly
     std::uint64_t sum = 0;
     for (std::uint32_t c = 0; c < 8; ++c) {
       CHECK(lod->budgets()[c] <= h->capacity(c));
+      if (r <= h->local_contractions) CHECK(lod->budgets()[c] <= h->local_capacity(c));
       sum += lod->budgets()[c];
     }
     CHECK(sum == r);
+    std::size_t removed = 0;  // the triangle count follows from the applied contractions
+    for (std::uint32_t i = 0; i < h->contraction_count(); ++i)
+      if (i < lod->stop_points()[h->owner[i]]) removed += h->faces_removed[i];
+    CHECK(st->indices == 3 * (m.triangle_count() - removed));
     CHECK(closed_and_manifold(std::span<const std::uint32_t>(out.data(), st->indices)));
   }
   // Bad input.

@@ -13,8 +13,16 @@
 // performs no contraction.
 // A contraction is refused when it would: create a non-manifold edge or a duplicate triangle
 // (link condition: the common neighbours of u and v are exactly the vertices opposite edge uv),
-// flip or flatten a triangle (old and new normal must have a positive dot product), or move a
+// flip or flatten a triangle (the angle between old and new normal must stay below
+// acos(min_normal_cos), so the dot product stays positive), or move a
 // mesh-boundary vertex off its boundary (a boundary u may only move along a boundary edge).
+// Cluster-local phase (cluster_local_first): with one global order, a cluster performs a prefix
+// of it, so depending on one late contraction of a neighbour means performing all of that
+// neighbour's earlier ones; near the coarse end every contraction depends on late neighbours,
+// and neighbour matching would drag every cluster to the coarsest one. So the build first
+// performs only contractions whose removed vertex, target and both 1-rings are all owned by one
+// cluster: these depend on nothing outside it, and clusters simplify independently until only
+// bands along their borders are left; then contractions run over the whole mesh as above.
 // Simplification stops at the backstop: backstop × V vertices left (the paper stops at 1%).
 //
 // Hierarchy: for contraction i (its global order): removed[i], target[i], and parent[i], the
@@ -22,12 +30,14 @@
 // triangle fan of u, v or any neighbour of u or v (none: no_parent). Each contraction belongs
 // to the cluster owning its removed vertex (the cluster of the vertex's lowest-index triangle);
 // a cluster's capacity is the number of contractions it owns (what distribute_contractions
-// needs). dependency_clusters lists, per cluster, the clusters owning any contraction that one
-// of its contractions depends on (the "neighbouring clusters" of neighbour matching).
+// needs). For neighbour matching, each contraction whose dependencies include contractions
+// owned by other clusters records, per such cluster, the latest of them (cross_dependency):
+// dependencies inside the own cluster are met by construction (a cluster always performs a
+// prefix of its contractions in global order).
 //
 // Preconditions: an edge-manifold mesh (checked), finite positions (checked).
 // Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
-// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
+// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per cross-cluster dependency, 12 per
 // triangle (the cluster-ordered index buffer) and 4 per vertex.
 #include <algorithm>
 #include <cmath>
@@ -50,6 +60,14 @@ inline constexpr std::uint32_t no_parent = invalid_id;
 struct simplification_options {
   double backstop = 0.01;         // stop when this fraction of the vertices is left, in [0, 1]
   double boundary_weight = 10.0;  // weight of the planes that hold mesh-boundary edges, >= 0
+  double min_normal_cos = 0.0;    // a triangle's normal may turn by at most acos of this, in [0, 1)
+  bool cluster_local_first = true;  // first only contractions whose 2-ring lies in one cluster (see above)
+};
+
+struct cross_dependency {
+  std::uint32_t order;    // a contraction owned by the listing cluster
+  std::uint32_t cluster;  // another cluster
+  std::uint32_t needs;    // the latest contraction of `cluster` that `order` depends on
 };
 
 struct contraction_hierarchy {
@@ -59,23 +77,29 @@ struct contraction_hierarchy {
   std::vector<float> error;                 // its weighted quadric cost (Q_u + Q_v)(p_v)
   // Per vertex: the order of the contraction removing it, or invalid_id.
   std::vector<std::uint32_t> removal_order;
-  // Per cluster (CSR): owned contractions ascending, and the running maximum of their parents
-  // (no_parent while none has one).
-  std::vector<std::uint32_t> cluster_offsets, cluster_contractions, cluster_parent_max;
-  // Per cluster (CSR): clusters whose stop points neighbour matching may raise.
-  std::vector<std::uint32_t> dependency_offsets, dependency_clusters;
+  // Per cluster (CSR): owned contractions ascending.
+  std::vector<std::uint32_t> cluster_offsets, cluster_contractions;
+  // Per cluster (CSR): dependencies on other clusters' contractions, ascending by order.
+  std::vector<std::uint32_t> cross_offsets;
+  std::vector<cross_dependency> cross;
   // The mesh's triangles grouped by cluster (index buffer order, original vertex ids) and the
   // triangle offsets of each cluster.
   std::vector<std::uint32_t> indices, triangle_offsets;
   std::uint32_t vertex_count = 0, cluster_count = 0;
+  std::uint32_t local_contractions = 0;  // the first ones, that touch only their own cluster's vertices
 
   [[nodiscard]] std::size_t contraction_count() const { return removed.size(); }
   [[nodiscard]] std::size_t triangle_count() const { return indices.size() / 3; }
   [[nodiscard]] std::uint64_t capacity(std::uint32_t c) const { return cluster_offsets[c + 1] - cluster_offsets[c]; }
+  // Contractions of cluster c in the cluster-local phase (those with order < local_contractions).
+  [[nodiscard]] std::uint64_t local_capacity(std::uint32_t c) const {
+    const auto b = cluster_contractions.begin() + cluster_offsets[c], e = cluster_contractions.begin() + cluster_offsets[c + 1];
+    return static_cast<std::uint64_t>(std::lower_bound(b, e, local_contractions) - b);
+  }
   [[nodiscard]] std::size_t memory_bytes() const {
     return 4 * (removed.size() + target.size() + parent.size() + owner.size() + error.size() + removal_order.size() +
-                cluster_offsets.size() + cluster_contractions.size() + cluster_parent_max.size() +
-                dependency_offsets.size() + dependency_clusters.size() + indices.size() + triangle_offsets.size()) +
+                cluster_offsets.size() + cluster_contractions.size() + cross_offsets.size() + 3 * cross.size() +
+                indices.size() + triangle_offsets.size()) +
            faces_removed.size();
   }
 };
@@ -168,7 +192,7 @@ class collapse_mesh {
   }
   // The §III.C validity tests for u → v (see the top of the file). Leaves ring(u) in ring_u,
   // ring(v) in ring_v.
-  bool can_collapse(std::uint32_t u, std::uint32_t v) {
+  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
     std::uint32_t opp[2] = {nil, nil};
     const std::uint32_t k = shared_triangles(u, v, opp);
     if (k == 0 || k > 2) return false;
@@ -190,7 +214,7 @@ class collapse_mesh {
       for (int j = 0; j < 3; ++j)
         if (f[j] == u) p[j] = pv;
       const glm::dvec3 n1 = glm::cross(p[1] - p[0], p[2] - p[0]);
-      if (!(glm::dot(n0, n1) > 0.0)) ok = false;
+      if (!(glm::dot(n0, n1) > min_cos * glm::length(n0) * glm::length(n1))) ok = false;
       // A duplicate triangle (v, a, b) would appear when v already has one on a and b.
       std::uint32_t a = nil, b = nil;
       for (int j = 0; j < 3; ++j)
@@ -265,6 +289,8 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
                         cluster_count);
   if (!(opt.backstop >= 0.0 && opt.backstop <= 1.0))
     return make_error(errc::bad_parameter, no_element, "backstop ", opt.backstop, " must be in [0, 1]");
+  if (!(opt.min_normal_cos >= 0.0 && opt.min_normal_cos < 1.0))
+    return make_error(errc::bad_parameter, no_element, "min_normal_cos ", opt.min_normal_cos, " must be in [0, 1)");
   if (!(opt.boundary_weight >= 0.0) || !std::isfinite(opt.boundary_weight))
     return make_error(errc::bad_parameter, no_element, "boundary_weight ", opt.boundary_weight, " must be >= 0 and finite");
   auto topo = build_topology(m);
@@ -337,8 +363,8 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   h.vertex_count = static_cast<std::uint32_t>(nv);
   h.cluster_count = cluster_count;
   h.removal_order.assign(nv, invalid_id);
-  std::vector<std::uint64_t> dep_pairs;  // (owner << 32) | dependency owner
-  std::vector<std::uint32_t> dep_scratch;
+  std::vector<std::pair<std::uint32_t, cross_dependency>> crossing;  // (owner, entry), ascending order
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> dep_scratch;  // (cluster, order) of dependencies
 
   std::vector<detail::collapse_entry> heap;
   auto push = [&](std::uint32_t u, std::uint32_t v) {
@@ -360,10 +386,19 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     std::make_heap(heap.begin(), heap.end(), std::greater<>{});
   };
   fill();
-  bool progress_since_fill = false;
+  bool progress_since_fill = false, local_phase = opt.cluster_local_first;
+  auto local_to_cluster = [&](std::uint32_t c) {
+    for (std::uint32_t x : cm.ring_u) if (owner[x] != c) return false;
+    for (std::uint32_t x : cm.ring_v) if (owner[x] != c) return false;
+    return true;
+  };
   while (live > floor_count) {
     if (heap.empty()) {
-      if (!progress_since_fill) break;
+      if (!progress_since_fill && !local_phase) break;
+      if (!progress_since_fill) {
+        local_phase = false;
+        h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
+      }
       progress_since_fill = false;
       fill();
       continue;
@@ -372,7 +407,8 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     const detail::collapse_entry e = heap.back();
     heap.pop_back();
     if (!cm.alive[e.u] || !cm.alive[e.v] || cm.version[e.u] != e.ver_u || cm.version[e.v] != e.ver_v) continue;
-    if (!cm.can_collapse(e.u, e.v)) continue;
+    if (!cm.can_collapse(e.u, e.v, opt.min_normal_cos)) continue;
+    if (local_phase && !local_to_cluster(owner[e.u])) continue;
     // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
     const auto order = static_cast<std::uint32_t>(h.removed.size());
     std::uint32_t parent = no_parent;
@@ -381,14 +417,15 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       const std::uint32_t j = cm.last_touch[x];
       if (j == no_parent) return;
       parent = parent == no_parent ? j : std::max(parent, j);
-      dep_scratch.push_back(h.owner[j]);
+      if (h.owner[j] != owner[e.u]) dep_scratch.push_back({h.owner[j], j});
     };
     note(e.u), note(e.v);
     for (std::uint32_t x : cm.ring_u) note(x);
     for (std::uint32_t x : cm.ring_v) note(x);
     std::sort(dep_scratch.begin(), dep_scratch.end());
-    dep_scratch.erase(std::unique(dep_scratch.begin(), dep_scratch.end()), dep_scratch.end());
-    for (std::uint32_t c : dep_scratch) dep_pairs.push_back(std::uint64_t{owner[e.u]} << 32 | c);
+    for (std::size_t k = 0; k < dep_scratch.size(); ++k)  // the latest per cluster
+      if (k + 1 == dep_scratch.size() || dep_scratch[k + 1].first != dep_scratch[k].first)
+        crossing.push_back({owner[e.u], {order, dep_scratch[k].first, dep_scratch[k].second}});
     const std::uint8_t gone = cm.collapse(e.u, e.v);
     h.removed.push_back(e.u), h.target.push_back(e.v), h.parent.push_back(parent), h.owner.push_back(owner[e.u]);
     h.faces_removed.push_back(gone);
@@ -402,31 +439,24 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     for (std::uint32_t x : cm.ring_v) push(e.v, x), push(x, e.v);
   }
 
-  // Per-cluster contraction lists and their running parent maximum.
+  if (local_phase) h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
+  // Per-cluster contraction lists and cross-cluster dependencies (counting sorts, stable).
   h.cluster_offsets.assign(cluster_count + 1, 0);
   for (std::uint32_t c : h.owner) ++h.cluster_offsets[c + 1];
   for (std::uint32_t c = 0; c < cluster_count; ++c) h.cluster_offsets[c + 1] += h.cluster_offsets[c];
   h.cluster_contractions.resize(h.owner.size());
-  h.cluster_parent_max.resize(h.owner.size());
   {
     std::vector<std::uint32_t> cursor(h.cluster_offsets.begin(), h.cluster_offsets.end() - 1);
-    for (std::uint32_t i = 0; i < h.owner.size(); ++i) {
-      const std::uint32_t c = h.owner[i], k = cursor[c]++;
-      h.cluster_contractions[k] = i;
-      const std::uint32_t prev = k > h.cluster_offsets[c] ? h.cluster_parent_max[k - 1] : no_parent;
-      const std::uint32_t p = h.parent[i];
-      h.cluster_parent_max[k] = prev == no_parent ? p : (p == no_parent ? prev : std::max(prev, p));
-    }
+    for (std::uint32_t i = 0; i < h.owner.size(); ++i) h.cluster_contractions[cursor[h.owner[i]]++] = i;
   }
-  std::sort(dep_pairs.begin(), dep_pairs.end());
-  dep_pairs.erase(std::unique(dep_pairs.begin(), dep_pairs.end()), dep_pairs.end());
-  h.dependency_offsets.assign(cluster_count + 1, 0);
-  h.dependency_clusters.resize(dep_pairs.size());
-  for (std::size_t k = 0; k < dep_pairs.size(); ++k) {
-    ++h.dependency_offsets[(dep_pairs[k] >> 32) + 1];
-    h.dependency_clusters[k] = static_cast<std::uint32_t>(dep_pairs[k]);
+  h.cross_offsets.assign(cluster_count + 1, 0);
+  for (const auto& x : crossing) ++h.cross_offsets[x.first + 1];
+  for (std::uint32_t c = 0; c < cluster_count; ++c) h.cross_offsets[c + 1] += h.cross_offsets[c];
+  h.cross.resize(crossing.size());
+  {
+    std::vector<std::uint32_t> cursor(h.cross_offsets.begin(), h.cross_offsets.end() - 1);
+    for (const auto& x : crossing) h.cross[cursor[x.first]++] = x.second;
   }
-  for (std::uint32_t c = 0; c < cluster_count; ++c) h.dependency_offsets[c + 1] += h.dependency_offsets[c];
   // Index buffer grouped by cluster (stable: triangle order inside a cluster is kept).
   h.triangle_offsets.assign(cluster_count + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) ++h.triangle_offsets[cluster[t] + 1];

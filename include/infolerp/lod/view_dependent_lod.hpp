@@ -4,7 +4,10 @@
 //
 //   1. A_est, I_est per cluster (eqs. 5–8, cluster_importance.hpp);
 //   2. eq. 9: the global budget R_global spread over clusters by A_est·I_est, each cluster
-//      clamped to its capacity (distribute_contractions);
+//      clamped to its cluster-local capacity (distribute_contractions; contraction_hierarchy.hpp
+//      explains the cluster-local phase). A budget beyond the local phase is a global prefix:
+//      every local contraction plus the first R_global − Σ local of the rest, the same for all
+//      clusters (a prefix of the global order needs no matching);
 //   3. stop points and neighbour matching (view_selection.hpp);
 //   4. vertex contraction into the caller's index buffer (vertex_contraction.hpp).
 // Each step is usable on its own; this class keeps their buffers between frames, so frame()
@@ -14,6 +17,7 @@
 // whether a camera is inside a mesh of many clusters would cost O(T) per frame; it is not tried
 // (clusters with peak normal deviations near π, common on real meshes, make A_est 0 from any
 // side, so A_est cannot tell either).
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -32,7 +36,7 @@ namespace infolerp {
 
 struct lod_frame_stats {
   std::size_t indices = 0;              // indices written
-  std::uint64_t budgeted = 0;           // Σ eq. 9 budgets (= min(R_global, Σ capacity))
+  std::uint64_t budgeted = 0;           // Σ per-cluster budgets (= R_global)
   std::uint64_t applied = 0;            // contractions applied after neighbour matching (>= budgeted)
   std::uint32_t matching_sweeps = 0;
 };
@@ -73,12 +77,17 @@ class view_dependent_lod {
     for (const cluster_attributes& c : table_->clusters) outside = outside || glm::length(c.centroid - camera) > c.radius;
     if (!outside)
       return make_error(errc::bad_parameter, no_element, "camera is inside every cluster's bounding sphere");
-    for (std::size_t k = 0; k < priority_.size(); ++k) priority_[k] = area_[k] * importance_[k];
-    if (status s = distribute_contractions(priority_, capacity_, global_contractions, lambda_perc_, order_, budget_);
-        !s.ok())
-      return s;
-    if (status s = stop_points_from_budgets(*h_, budget_, stop_); !s.ok()) return s;
     lod_frame_stats st;
+    if (global_contractions <= h_->local_contractions) {
+      for (std::size_t k = 0; k < priority_.size(); ++k) priority_[k] = area_[k] * importance_[k];
+      if (status s = distribute_contractions(priority_, capacity_, global_contractions, lambda_perc_, order_, budget_);
+          !s.ok())
+        return s;
+      if (status s = stop_points_from_budgets(*h_, budget_, stop_); !s.ok()) return s;
+    } else {
+      std::fill(stop_.begin(), stop_.end(), static_cast<std::uint32_t>(global_contractions));
+      for (std::uint32_t c = 0; c < h_->cluster_count; ++c) budget_[c] = applied_count(*h_, c, stop_[c]);
+    }
     for (std::uint64_t b : budget_) st.budgeted += b;
     st.matching_sweeps = match_neighbours(*h_, stop_);
     for (std::uint32_t c = 0; c < h_->cluster_count; ++c) st.applied += applied_count(*h_, c, stop_[c]);
@@ -94,7 +103,7 @@ class view_dependent_lod {
     const std::size_t c = h.cluster_count;
     area_.resize(c), importance_.resize(c), priority_.resize(c), order_.resize(c), budget_.resize(c), stop_.resize(c);
     capacity_.resize(c);
-    for (std::uint32_t k = 0; k < h.cluster_count; ++k) capacity_[k] = h.capacity(k);
+    for (std::uint32_t k = 0; k < h.cluster_count; ++k) capacity_[k] = h.local_capacity(k);
   }
   const contraction_hierarchy* h_;
   const cluster_table* table_;

@@ -6,13 +6,17 @@
 //
 // A cluster with budget b performs its first b owned contractions (in global order): its stop
 // point is one past the order of the b-th, and contraction i is applied iff i < stop[owner(i)].
-// Neighbour matching (§IV.A): for each cluster, the largest parent order D among its applied
-// contractions; every cluster in its dependency list whose stop point is <= D is raised to
-// D + 1. The paper does one sweep; raising a stop point applies more contractions whose own
-// parents may reach further, so the sweep repeats until nothing changes. At that fixed point
-// every applied contraction's dependencies are applied (each dependency j <= parent <= D lies in
-// a listed cluster whose stop point exceeds D), which keeps shared boundaries gap-free.
-// Matching only adds contractions: each cluster performs at least its budget.
+// Neighbour matching (§IV.A): the paper takes, per cluster, the largest parent order D among its
+// applied contractions and raises every neighbouring cluster's stop point to D. With one global
+// order that drags each neighbour to about the same place in the order as the most refined
+// cluster around it (on a mesh of ten clusters, to nearly every contraction), so this raises
+// per dependency instead: for each applied contraction with a dependency j owned by another
+// cluster c' (the latest such j per c', recorded at build time), stop[c'] becomes at least
+// j + 1. Raising a stop point applies more contractions with dependencies of their own, so the
+// sweep repeats until nothing changes. At that fixed point every applied contraction's
+// dependencies are applied (those in its own cluster come earlier in the same prefix), which
+// keeps shared boundaries gap-free. Matching only adds contractions: each cluster performs at
+// least its budget.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -47,22 +51,17 @@ inline std::uint32_t applied_count(const contraction_hierarchy& h, std::uint32_t
 }
 
 // Neighbour matching in place; returns the sweeps run (>= 1). Preconditions: stop holds one
-// entry per cluster. O(sweeps · (clusters · log capacity + dependency pairs)), no allocation.
+// entry per cluster. O(sweeps · applied cross-cluster dependencies), no allocation.
 inline std::uint32_t match_neighbours(const contraction_hierarchy& h, std::span<std::uint32_t> stop) {
   std::uint32_t sweeps = 0;
   for (bool changed = true; changed;) {
     changed = false;
     ++sweeps;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
-      const std::uint32_t n = applied_count(h, c, stop[c]);
-      if (n == 0) continue;
-      const std::uint32_t d = h.cluster_parent_max[h.cluster_offsets[c] + n - 1];
-      if (d == no_parent) continue;
-      for (std::uint32_t k = h.dependency_offsets[c]; k < h.dependency_offsets[c + 1]; ++k) {
-        std::uint32_t& s = stop[h.dependency_clusters[k]];
-        if (s <= d) s = d + 1, changed = true;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+      for (std::uint32_t k = h.cross_offsets[c]; k < h.cross_offsets[c + 1] && h.cross[k].order < stop[c]; ++k) {
+        std::uint32_t& s = stop[h.cross[k].cluster];
+        if (s <= h.cross[k].needs) s = h.cross[k].needs + 1, changed = true;
       }
-    }
   }
   return sweeps;
 }
