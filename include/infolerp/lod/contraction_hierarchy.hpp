@@ -321,8 +321,8 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       cm.tri_alive[t] = 0;  // a repeated index draws nothing; it never joins a corner list
       continue;
     }
-    for (std::uint32_t j = 0; j < 3; ++j) {
-      const std::uint32_t c = 3 * static_cast<std::uint32_t>(t) + j;
+    for (int j = 0; j < 3; ++j) {
+      const std::uint32_t c = 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(j);
       cm.next[c] = cm.head[f[j]];
       cm.head[f[j]] = c;
       cm.alive[f[j]] = 1;
@@ -334,7 +334,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     if (!(len > 0.0)) continue;
     const glm::dvec3 n = n2 / len;
     const double d = -glm::dot(n, p0), area = 0.5 * len;
-    for (std::uint32_t j = 0; j < 3; ++j) cm.q[f[j]].add_plane(n, d, area * weights[3 * t + j]);
+    for (int j = 0; j < 3; ++j) cm.q[f[j]].add_plane(n, d, area * weights[3 * t + static_cast<std::size_t>(j)]);
   }
   // Boundary planes.
   for (std::size_t e = 0; e < topo->edge_count(); ++e) {
