@@ -1,4 +1,7 @@
-// infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N]
+// infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A] [--percentile P]
+//                     [--only-given] [--no-frames]
+// (--amplification, --percentile: the weighting map's λ and α, defaults 100 and 30; --only-given:
+// only the --mesh meshes; --no-frames: no frame rows)
 //
 // View-dependent multiresolution rendering (salient-clustering paper §III.C, §IV) against
 // meshoptimizer's meshopt_simplify, the simplifier an engine would otherwise call.
@@ -15,14 +18,18 @@
 //   Closest points come from a uniform grid of triangles searched in growing shells (exact).
 //   Seconds: the minimum of --reps repetitions, the methods interleaved in one loop.
 //   The hierarchy is built with backstop 0.005 (half a percent of the vertices, about 1% of the
-//   triangles), so that the 1% row exists; 10 salient clusters, default weighting map.
+//   triangles), so that the 1% row exists, and in one global order (cluster_local_first off, as
+//   §III.C simplifies "over the entire mesh"; a uniform prefix of the cluster-local order keeps
+//   full-resolution bands along cluster borders); 10 salient clusters, default weighting map.
+//   The frame rows use the default hierarchy (cluster-local phase first).
 //   kind=frame, mesh refined_elephant_x4 (refined_elephant subdivided once 1:4 at edge
 //   midpoints, 355,712 triangles), fraction 0.05, 0.35, 0.60 of the triangles: method update
 //   (view_dependent_lod::frame: importance, eq. 9, matching, contraction into the index buffer;
 //   serial executor; camera 2 diagonals above the box centre; global budget (1 − f)·T/2
 //   contractions), memcpy (the full-resolution index buffer), meshoptimizer (meshopt_simplify to
 //   the triangle count update produced, from scratch); minimum over --reps repetitions
-//   interleaved in one loop. Distances are left empty for frame rows.
+//   interleaved in one loop. Distances are left empty for frame rows. stdout also gives the
+//   update with openmp_executor{2} (checked to produce the same index buffer) and medians.
 // stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios.
 #include <meshoptimizer.h>
 #include <algorithm>
@@ -102,7 +109,7 @@ class surface_distance {
     const glm::dvec3 ext = box.hi - box.lo;
     h_ = std::max(std::cbrt(ext.x * ext.y * ext.z / std::max<double>(1.0, static_cast<double>(nt))), 1e-9 * box.diagonal());
     for (int a = 0; a < 3; ++a) n_[a] = std::max(1, static_cast<int>(std::ceil(ext[a] / h_)));
-    cells_.resize(static_cast<std::size_t>(n_[0]) * n_[1] * n_[2]);
+    cells_.resize(static_cast<std::size_t>(n_[0]) * static_cast<std::size_t>(n_[1]) * static_cast<std::size_t>(n_[2]));
     for (std::size_t t = 0; t < nt; ++t) {
       glm::dvec3 l(std::numeric_limits<double>::max()), u(-std::numeric_limits<double>::max());
       for (int j = 0; j < 3; ++j) {
@@ -193,6 +200,8 @@ struct prepared {
   std::vector<double> weights;
 };
 
+weighting_map_options g_weighting;  // --amplification, --percentile
+
 bool prepare(const indexed_mesh& m, prepared& p) {
   auto sal = compute_saliency(m);
   if (!sal.ok()) return std::fprintf(stderr, "saliency: %s\n", sal.error().message().c_str()), false;
@@ -200,10 +209,7 @@ bool prepare(const indexed_mesh& m, prepared& p) {
   auto cl = salient_clustering(m, p.saliency, {.clusters = 10});
   if (!cl.ok()) return std::fprintf(stderr, "clustering: %s\n", cl.error().message().c_str()), false;
   p.clusters = std::move(*cl);
-  weighting_map_options wo;
-  if (const char* a = std::getenv("LOD_AMP")) wo.amplification = std::atof(a);
-  if (const char* a = std::getenv("LOD_PCT")) wo.amplify_percentile = std::atof(a);
-  auto w = weighting_map(m, p.saliency, p.clusters.cluster, p.clusters.count, wo);
+  auto w = weighting_map(m, p.saliency, p.clusters.cluster, p.clusters.count, g_weighting);
   if (!w.ok()) return std::fprintf(stderr, "weighting map: %s\n", w.error().message().c_str()), false;
   p.weights = std::move(*w);
   return true;
@@ -233,12 +239,12 @@ void simplify_rows(std::FILE* csv, const std::string& name, const indexed_mesh& 
   const std::size_t nt = m.triangle_count();
   const std::array<double, 4> fractions{0.35, 0.10, 0.05, 0.01};
   const auto* idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
-  std::vector<double> build_s(reps), mo_s(fractions.size() * static_cast<std::size_t>(reps)), sel_s(mo_s.size());
+  std::vector<double> build_s(static_cast<std::size_t>(reps)), mo_s(fractions.size() * static_cast<std::size_t>(reps)), sel_s(mo_s.size());
   std::vector<std::vector<std::uint32_t>> mo_out(fractions.size()), our_out(fractions.size());
   contraction_hierarchy h;
   for (int r = 0; r < reps; ++r) {
     auto t0 = clk::now();
-    auto built = build_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .min_normal_cos = std::getenv("LOD_COS") ? std::atof(std::getenv("LOD_COS")) : 0.0});
+    auto built = build_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .cluster_local_first = false});
     build_s[static_cast<std::size_t>(r)] = seconds_since(t0);
     if (!built.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), built.error().message().c_str()));
     h = std::move(*built);
@@ -298,17 +304,19 @@ void frame_rows(std::FILE* csv, int reps) {
   const bounding_box box = mesh_bounds(m);
   const glm::dvec3 camera = box.center() + glm::dvec3(0.0, 0.0, 2.0 * box.diagonal());
   const auto* idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
-  std::vector<std::uint32_t> out(contracted_index_bound(*h)), copy(3 * nt), mo(3 * nt);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), out2(out.size()), copy(3 * nt), mo(3 * nt);
   std::vector<index_range> ranges(h->cluster_count);
   for (double f : {0.05, 0.35, 0.60}) {
     const auto budget = std::min<std::uint64_t>(lod->capacity(),
                                                 static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(nt) / 2.0));
-    double upd = 1e30, cp = 1e30, ms = 1e30;
+    double upd = 1e30, upd2 = 1e30, cp = 1e30, ms = 1e30;
+    std::vector<double> upd_all, cp_all;
     std::size_t tris = 0, mo_tris = 0;
     for (int r = 0; r < reps; ++r) {
       auto t = clk::now();
       auto st = lod->frame(camera, budget, out, ranges);
       upd = std::min(upd, seconds_since(t));
+      upd_all.push_back(seconds_since(t));
       if (!st.ok()) return void(std::fprintf(stderr, "%s\n", st.error().message().c_str()));
       tris = st->indices / 3;
       if (r == 0)
@@ -318,7 +326,13 @@ void frame_rows(std::FILE* csv, int reps) {
       t = clk::now();
       std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
       cp = std::min(cp, seconds_since(t));
-      if (copy[r % 7] != idx[r % 7]) std::abort();  // keeps the copy
+      cp_all.push_back(seconds_since(t));
+      t = clk::now();
+      auto st2 = lod->frame(camera, budget, out2, ranges, openmp_executor{2});
+      upd2 = std::min(upd2, seconds_since(t));
+      if (!st2.ok() || st2->indices != st->indices || !std::equal(out.begin(), out.begin() + static_cast<long>(st->indices), out2.begin()))
+        return void(std::fprintf(stderr, "two threads gave another index buffer\n"));
+      if (copy[static_cast<std::size_t>(r % 7)] != idx[r % 7]) std::abort();  // keeps the copy
       t = clk::now();
       mo_tris = meshopt_simplify(mo.data(), idx, 3 * nt, &m.positions[0].x, m.vertex_count(), sizeof(glm::vec3), 3 * tris,
                                  std::numeric_limits<float>::max(), 0, nullptr) / 3;
@@ -327,7 +341,10 @@ void frame_rows(std::FILE* csv, int reps) {
     row(csv, "frame", "refined_elephant_x4", "update", f, tris, upd, nullptr);
     row(csv, "frame", "refined_elephant_x4", "memcpy", f, nt, cp, nullptr);
     row(csv, "frame", "refined_elephant_x4", "meshoptimizer", f, mo_tris, ms, nullptr);
-    std::printf("# fraction %.2f: update/memcpy %.2f, meshoptimizer/update %.1f\n", f, upd / cp, ms / upd);
+    auto median = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v[v.size() / 2]; };
+    std::printf("# fraction %.2f: update/memcpy %.2f (medians %.2f), meshoptimizer/update %.1f; update with 2 OpenMP threads %.6g s, "
+                "/memcpy %.2f (identical index buffer)\n",
+                f, upd / cp, median(upd_all) / median(cp_all), ms / upd, upd2, upd2 / cp);
   }
 }
 
@@ -337,13 +354,19 @@ int pareto_lod(int argc, char** argv) {
   std::string csv_path;
   std::vector<std::string> extra;
   int reps = 5;
+  bool builtin = true, frames = true;
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
     else if (!std::strcmp(argv[i], "--mesh")) extra.push_back(next());
     else if (!std::strcmp(argv[i], "--reps")) reps = std::max(1, std::atoi(next().c_str()));
+    else if (!std::strcmp(argv[i], "--amplification")) g_weighting.amplification = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--percentile")) g_weighting.amplify_percentile = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--only-given")) builtin = false;
+    else if (!std::strcmp(argv[i], "--no-frames")) frames = false;
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A]"
+                   " [--percentile P] [--only-given] [--no-frames]\n");
       return 2;
     }
   }
@@ -355,8 +378,8 @@ int pareto_lod(int argc, char** argv) {
   if (!csv) return std::fprintf(stderr, "cannot write %s\n", csv_path.c_str()), 1;
   std::fprintf(csv, "kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff\n");
   std::vector<std::pair<std::string, std::string>> meshes;
-  if (!std::getenv("LOD_ONLY_EXTRA"))
-  for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));
+  if (builtin)
+    for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));
   for (const std::string& path : extra) {
     const std::size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
     const std::size_t b = slash == std::string::npos ? 0 : slash + 1;
@@ -370,7 +393,7 @@ int pareto_lod(int argc, char** argv) {
     }
     simplify_rows(csv, name, *m, reps);
   }
-  if (!std::getenv("LOD_NO_FRAME")) frame_rows(csv, reps);
+  if (frames) frame_rows(csv, reps);
   std::fclose(csv);
   return 0;
 }
