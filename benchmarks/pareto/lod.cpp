@@ -52,6 +52,7 @@
 #include "infolerp/saliency/salient_clustering.hpp"
 #include "pareto.hpp"
 #include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
 
 namespace {
 
@@ -59,23 +60,6 @@ using namespace infolerp;
 using clk = std::chrono::steady_clock;
 
 double seconds_since(clk::time_point t0) { return std::chrono::duration<double>(clk::now() - t0).count(); }
-
-indexed_mesh subdivide_midpoint(const indexed_mesh& in) {
-  indexed_mesh out;
-  out.positions = in.positions;
-  std::map<std::pair<unsigned, unsigned>, unsigned> mid;
-  auto midpoint = [&](unsigned a, unsigned b) {
-    const auto key = std::minmax(a, b);
-    auto [it, inserted] = mid.emplace(key, static_cast<unsigned>(out.positions.size()));
-    if (inserted) out.positions.push_back(0.5f * (in.positions[a] + in.positions[b]));
-    return it->second;
-  };
-  for (const auto& t : in.triangles) {
-    const unsigned a = midpoint(t.x, t.y), b = midpoint(t.y, t.z), c = midpoint(t.z, t.x);
-    out.triangles.insert(out.triangles.end(), {{t.x, a, c}, {t.y, b, a}, {t.z, c, b}, {a, b, c}});
-  }
-  return out;
-}
 
 // Closest point on triangle abc to p (Ericson, Real-Time Collision Detection §5.1.5).
 glm::dvec3 closest_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
@@ -287,7 +271,7 @@ void simplify_rows(std::FILE* csv, const std::string& name, const indexed_mesh& 
 void frame_rows(std::FILE* csv, int reps) {
   auto base = support::load_mesh(support::cgal_mesh("refined_elephant"));
   if (!base.ok()) return void(std::fprintf(stderr, "%s\n", base.error().message().c_str()));
-  const indexed_mesh m = subdivide_midpoint(*base);
+  const indexed_mesh m = support::subdivide_midpoint(*base);
   prepared p;
   if (!prepare(m, p)) return;
   const auto t0 = clk::now();

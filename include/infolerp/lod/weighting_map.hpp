@@ -61,26 +61,11 @@ inline void amplify_weights(std::span<double> values, double percentile, double 
 template <class M, class E = serial_executor>
 std::vector<double> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
                                          std::size_t grain = 1) {
-  const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
-  std::vector<char> used(nv, 0);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 tri = mesh_triangle(m, t);
-    used[tri.x] = used[tri.y] = used[tri.z] = 1;
-  }
-  std::vector<glm::dvec3> pts;
-  std::vector<double> vals, ones;
-  std::vector<std::uint32_t> ids;
-  for (std::size_t v = 0; v < nv; ++v)
-    if (used[v]) {
-      pts.push_back(glm::dvec3(mesh_position(m, v)));
-      vals.push_back(values[v]);
-      ids.push_back(static_cast<std::uint32_t>(v));
-    }
-  ones.assign(pts.size(), 1.0);
-  const detail::point_grid grid = detail::make_point_grid(pts, vals, ones, ids, 2.0 * sigma);
+  const detail::point_grid grid =
+      detail::referenced_point_grid(m, detail::referenced_vertices(m), values, 2.0 * sigma);
   const std::vector<double> avg = detail::exact_gaussian_averages(exec, grid, {sigma}, grain);
   std::vector<double> out(values.begin(), values.end());
-  for (std::size_t k = 0; k < pts.size(); ++k) out[grid.id[k]] = avg[k];
+  for (std::size_t k = 0; k < grid.id.size(); ++k) out[grid.id[k]] = avg[k];
   return out;
 }
 
