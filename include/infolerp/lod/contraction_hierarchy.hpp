@@ -29,16 +29,17 @@
 // order of the last contraction it depends on: the latest contraction that changed the
 // triangle fan of u, v or any neighbour of u or v (none: no_parent). Each contraction belongs
 // to the cluster owning its removed vertex (the cluster of the vertex's lowest-index triangle);
-// a cluster's capacity is the number of contractions it owns (what distribute_contractions
-// needs). For neighbour matching, each contraction whose dependencies include contractions
-// owned by other clusters records, per such cluster, the latest of them (cross_dependency):
+// a cluster's capacity is the number of contractions it owns, its local capacity those of the
+// cluster-local phase (what view_dependent_lod hands distribute_contractions). For neighbour
+// matching, each contraction whose dependencies include contractions owned by other clusters
+// records, per such cluster, the latest of them (cross_dependency):
 // dependencies inside the own cluster are met by construction (a cluster always performs a
 // prefix of its contractions in global order).
 //
 // Preconditions: an edge-manifold mesh (checked), finite positions (checked).
 // Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
-// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per cross-cluster dependency, 12 per
-// triangle (the cluster-ordered index buffer) and 4 per vertex.
+// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
+// cross-cluster dependency, 12 per triangle (the cluster-ordered index buffer), 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
