@@ -21,31 +21,14 @@
 #include "infolerp/core/executor.hpp"
 #include "infolerp/saliency/mesh_saliency.hpp"
 #include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
 
 namespace {
-
-// Midpoint 1:4 subdivision (each triangle into four; new vertices at edge midpoints).
-infolerp::indexed_mesh subdivide_midpoint(const infolerp::indexed_mesh& in) {
-  infolerp::indexed_mesh out;
-  out.positions = in.positions;
-  std::map<std::pair<unsigned, unsigned>, unsigned> mid;
-  auto midpoint = [&](unsigned a, unsigned b) {
-    const auto key = std::minmax(a, b);
-    auto [it, inserted] = mid.emplace(key, static_cast<unsigned>(out.positions.size()));
-    if (inserted) out.positions.push_back(0.5f * (in.positions[a] + in.positions[b]));
-    return it->second;
-  };
-  for (const auto& t : in.triangles) {
-    const unsigned a = midpoint(t.x, t.y), b = midpoint(t.y, t.z), c = midpoint(t.z, t.x);
-    out.triangles.insert(out.triangles.end(), {{t.x, a, c}, {t.y, b, a}, {t.z, c, b}, {a, b, c}});
-  }
-  return out;
-}
 
 const infolerp::indexed_mesh* elephant_subdivided() {
   static std::optional<infolerp::indexed_mesh> mesh = [] {
     auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("refined_elephant"));
-    return m.ok() ? std::optional(subdivide_midpoint(*m)) : std::nullopt;
+    return m.ok() ? std::optional(infolerp::support::subdivide_midpoint(*m)) : std::nullopt;
   }();
   return mesh ? &*mesh : nullptr;
 }

@@ -22,3 +22,4 @@ inline double linear_psnr(const std::vector<glm::vec3>& a, const std::vector<glm
   const double mse = se / double(a.size());
   return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
 }
+[[gnu::weak]] int pareto_lod(int argc, char** argv);

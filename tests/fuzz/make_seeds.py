@@ -86,3 +86,16 @@ write("fuzz_cluster", "icosahedron_uv", bytes([5, 76, 10, 25, 6, 1, 16, 8, 2]) +
 write("fuzz_cluster", "octahedron_exact_rows", bytes([2, 127, 5, 25, 4, 2, 0, 0, 0]) + mesh(OCTA_V, OCTA_T))
 write("fuzz_cluster", "two_pieces", bytes([4, 40, 60, 25, 3, 1, 9, 0, 10]) +
       mesh(OCTA_V + [(3, 3, 3), (4, 3, 3), (3, 4, 3)], OCTA_T + [(6, 7, 8)]))
+
+# fuzz_lod: [flags][backstop][cluster count - 1][mesh][cluster id per triangle][weight per corner][budgets]
+# flags: 1 ids may be out of range, 2 one weight too many, 4 uniform weights (none read), 8 no
+# cluster-local phase, 16 neighbour matching, bits 5-7 chunk grain - 1.
+PLANE_V = [(x * 0.5, y * 0.5, 0) for y in range(4) for x in range(4)]
+PLANE_T = [t for y in range(3) for x in range(3)
+           for t in [(y * 4 + x, y * 4 + x + 1, y * 4 + x + 5), (y * 4 + x, y * 4 + x + 5, y * 4 + x + 4)]]
+write("fuzz_lod", "icosahedron_matched", bytes([16, 0, 2]) + mesh(ICO_V, ICO_T) + bytes([t % 3 for t in range(20)]) +
+      bytes([(7 * k) % 254 for k in range(60)]) + bytes([5, 2, 9]))
+write("fuzz_lod", "octahedron_uniform_global", bytes([4 | 8 | 16 | 0x40, 0, 1]) + mesh(OCTA_V, OCTA_T) +
+      bytes([0, 1] * 4) + bytes([3, 4]))
+write("fuzz_lod", "plane_boundary", bytes([4, 0, 1]) + mesh(PLANE_V, PLANE_T) + bytes([t // 9 for t in range(18)]) +
+      bytes([6, 7]))

@@ -141,6 +141,23 @@ void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m) {
   dst.normals.clear();
 }
 
+indexed_mesh subdivide_midpoint(const indexed_mesh& in) {
+  indexed_mesh out;
+  out.positions = in.positions;
+  std::map<std::pair<unsigned, unsigned>, unsigned> mid;
+  auto midpoint = [&](unsigned a, unsigned b) {
+    const auto key = std::minmax(a, b);
+    auto [it, inserted] = mid.emplace(key, static_cast<unsigned>(out.positions.size()));
+    if (inserted) out.positions.push_back(0.5f * (in.positions[a] + in.positions[b]));
+    return it->second;
+  };
+  for (const auto& t : in.triangles) {
+    const unsigned a = midpoint(t.x, t.y), b = midpoint(t.y, t.z), c = midpoint(t.z, t.x);
+    out.triangles.insert(out.triangles.end(), {{t.x, a, c}, {t.y, b, a}, {t.z, c, b}, {a, b, c}});
+  }
+  return out;
+}
+
 }  // namespace infolerp::support
 
 namespace infolerp::support {

@@ -17,6 +17,9 @@ indexed_mesh make_uv_sphere(unsigned slices, unsigned stacks, float radius = 1.0
 indexed_mesh make_plane(unsigned nx, unsigned ny, float size);
 // Axis-aligned box, 8 shared vertices, 12 triangles, outward winding.
 indexed_mesh make_box(glm::vec3 lo, glm::vec3 hi);
+// Midpoint 1:4 subdivision: each triangle into four, new vertices at edge midpoints (shared
+// between the two triangles of an edge). Texcoords and normals are dropped. O(T log T).
+indexed_mesh subdivide_midpoint(const indexed_mesh& in);
 // Appends `src` transformed by `m` to `dst` (texcoords kept only if both have them, or dst is empty).
 void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m = glm::mat4(1.0f));
 

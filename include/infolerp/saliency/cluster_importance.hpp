@@ -106,15 +106,17 @@ struct view_importance {
   std::vector<double> importance_estimate;  // I_est per cluster (eq. 8)
 };
 
-// A_est and I_est of every cluster for a camera at camera_position. Errors: a non-finite
-// camera position (bad_parameter). Complexity O(clusters); allocation: the result. Pure, thread-safe.
-inline result<view_importance> estimate_view_importance(const cluster_table& table, const glm::dvec3& camera_position) {
+// A_est and I_est of every cluster for a camera at camera_position, into caller-owned spans of
+// one entry per cluster. Errors: a non-finite camera position (bad_parameter), spans of the
+// wrong size (bad_size). Complexity O(clusters); no allocation unless an error is returned.
+inline status estimate_view_importance(const cluster_table& table, const glm::dvec3& camera_position,
+                                       std::span<double> area_estimate, std::span<double> importance_estimate) {
   if (!std::isfinite(camera_position.x) || !std::isfinite(camera_position.y) || !std::isfinite(camera_position.z))
     return make_error(errc::bad_parameter, no_element, "camera position is not finite");
   const auto& cs = table.clusters;
-  view_importance out;
-  out.area_estimate.resize(cs.size());
-  out.importance_estimate.resize(cs.size());
+  if (area_estimate.size() != cs.size() || importance_estimate.size() != cs.size())
+    return make_error(errc::bad_size, no_element, "importance spans hold ", area_estimate.size(), " and ",
+                      importance_estimate.size(), " entries for ", cs.size(), " clusters");
   double fallback = 1.0;  // λ_dist for a "zero" case with no earlier positive value
   for (const auto& c : cs)
     if (const double d = glm::length(c.centroid - camera_position) - c.radius; d > 0.0) {
@@ -133,36 +135,51 @@ inline result<view_importance> estimate_view_importance(const cluster_table& tab
     double lambda_dist = vlen - c.radius;
     if (lambda_dist > 0.0) last = lambda_dist;
     else lambda_dist = last;
-    out.area_estimate[k] = lambda_angle / lambda_dist * c.area;
-    out.importance_estimate[k] = table.mesh_saliency > 0.0
+    area_estimate[k] = lambda_angle / lambda_dist * c.area;
+    importance_estimate[k] = table.mesh_saliency > 0.0
         ? c.total_saliency * c.peak_saliency * c.mean_saliency / table.mesh_saliency
         : 0.0;
   }
+  return {};
+}
+
+// The same, returning new vectors. Allocation: the result. Pure, thread-safe.
+inline result<view_importance> estimate_view_importance(const cluster_table& table, const glm::dvec3& camera_position) {
+  view_importance out;
+  out.area_estimate.resize(table.clusters.size());
+  out.importance_estimate.resize(table.clusters.size());
+  if (status s = estimate_view_importance(table, camera_position, out.area_estimate, out.importance_estimate); !s.ok())
+    return s;
   return out;
 }
 
 // Eq. (9): contractions per cluster from a global target. priority[k] = A_est·I_est;
-// capacity[k] = the most contractions cluster k allows. Errors: sizes differ (bad_size),
-// lambda_perc outside (0, 1] or a non-finite priority (bad_parameter). The sum of the result is
+// capacity[k] = the most contractions cluster k allows. The result goes to out, with `order`
+// as scratch (both one entry per cluster). Errors: sizes differ (bad_size), lambda_perc
+// outside (0, 1] or a non-finite priority (bad_parameter). The sum of the result is
 // min(global_target, Σ capacity). Complexity O(C log C + C · passes), passes <= 1/lambda_perc + C.
-// Allocation: the result and a sorted order (O(C)). Pure, thread-safe.
-inline result<std::vector<std::uint64_t>> distribute_contractions(std::span<const double> priority,
-                                                                  std::span<const std::uint64_t> capacity,
-                                                                  std::uint64_t global_target, double lambda_perc = 0.02) {
+// No allocation unless an error is returned (the sort is in place).
+inline status distribute_contractions(std::span<const double> priority, std::span<const std::uint64_t> capacity,
+                                      std::uint64_t global_target, double lambda_perc, std::span<std::size_t> order,
+                                      std::span<std::uint64_t> out) {
   if (priority.size() != capacity.size())
     return make_error(errc::bad_size, capacity.size(), "priority has ", priority.size(), " entries, capacity ",
                       capacity.size());
+  if (order.size() != priority.size() || out.size() != priority.size())
+    return make_error(errc::bad_size, out.size(), "order and out hold ", order.size(), " and ", out.size(),
+                      " entries for ", priority.size(), " clusters");
   if (!(lambda_perc > 0.0 && lambda_perc <= 1.0))
     return make_error(errc::bad_parameter, no_element, "lambda_perc ", lambda_perc, " must be in (0, 1]");
   for (std::size_t k = 0; k < priority.size(); ++k)
     if (!std::isfinite(priority[k]))
       return make_error(errc::bad_parameter, k, "cluster ", k, ": priority is not finite");
-  std::vector<std::size_t> order(priority.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return priority[a] < priority[b]; });
+  // std::sort does not allocate; equal priorities keep index order (the comparison includes it).
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return priority[a] < priority[b] || (priority[a] == priority[b] && a < b); });
   const auto step = std::max<std::uint64_t>(
       1, static_cast<std::uint64_t>(std::ceil(lambda_perc * static_cast<double>(global_target))));
-  std::vector<std::uint64_t> out(priority.size(), 0);
+  std::fill(out.begin(), out.end(), std::uint64_t{0});
   std::uint64_t remaining = global_target;
   bool progress = true;
   while (remaining > 0 && progress) {
@@ -176,6 +193,17 @@ inline result<std::vector<std::uint64_t>> distribute_contractions(std::span<cons
       progress = true;
     }
   }
+  return {};
+}
+
+// The same, returning a new vector. Allocation: the result and a sorted order (O(C)). Pure,
+// thread-safe.
+inline result<std::vector<std::uint64_t>> distribute_contractions(std::span<const double> priority,
+                                                                  std::span<const std::uint64_t> capacity,
+                                                                  std::uint64_t global_target, double lambda_perc = 0.02) {
+  std::vector<std::size_t> order(priority.size());
+  std::vector<std::uint64_t> out(priority.size(), 0);
+  if (status s = distribute_contractions(priority, capacity, global_target, lambda_perc, order, out); !s.ok()) return s;
   return out;
 }
 

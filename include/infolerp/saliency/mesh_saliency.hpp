@@ -231,6 +231,34 @@ inline point_grid make_point_grid(const std::vector<glm::dvec3>& pts, const std:
   return g;
 }
 
+// used[v] = 1 when a triangle references vertex v. O(V + T), allocation O(V).
+template <class M>
+std::vector<char> referenced_vertices(const M& m) {
+  std::vector<char> used(mesh_vertex_count(m), 0);
+  for (std::size_t t = 0; t < mesh_triangle_count(m); ++t) {
+    const glm::uvec3 tri = mesh_triangle(m, t);
+    used[tri.x] = used[tri.y] = used[tri.z] = 1;
+  }
+  return used;
+}
+
+// A point_grid over the referenced vertices (value values[v], weight 1, id v). O(V + cells).
+template <class M>
+point_grid referenced_point_grid(const M& m, const std::vector<char>& used, std::span<const double> values,
+                                 double min_cell) {
+  std::vector<glm::dvec3> pts;
+  std::vector<double> vals, ones;
+  std::vector<std::uint32_t> ids;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v]) {
+      pts.push_back(glm::dvec3(mesh_position(m, v)));
+      vals.push_back(values[v]);
+      ids.push_back(static_cast<std::uint32_t>(v));
+    }
+  ones.assign(pts.size(), 1.0);
+  return make_point_grid(pts, vals, ones, ids, min_cell);
+}
+
 inline constexpr std::size_t block_lanes = 8;  // candidates per block of the pair kernel
 
 // Rows of n doubles rounded up to a multiple of 8 (whole blocks), each 64-byte aligned when the
@@ -776,7 +804,7 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   mesh_saliency out;
   out.curvature = std::move(*curv);
   out.epsilon = opt.epsilon * box.diagonal();
-  const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
+  const std::size_t nv = mesh_vertex_count(m);
 
   // Distinct σ multipliers (σ_i and 2σ_i), ascending; level i uses entries lo[i] and hi[i].
   std::vector<double> mult;
@@ -801,23 +829,9 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   };
 
   // Referenced vertices only: an unused vertex has no curvature and must not dilute averages.
-  std::vector<char> used(nv, 0);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 tri = mesh_triangle(m, t);
-    used[tri.x] = used[tri.y] = used[tri.z] = 1;
-  }
-  std::vector<glm::dvec3> pts;
-  std::vector<double> vals, ones;
-  std::vector<std::uint32_t> ids;
-  for (std::size_t v = 0; v < nv; ++v)
-    if (used[v]) {
-      pts.push_back(glm::dvec3(mesh_position(m, v)));
-      vals.push_back(out.curvature[v]);
-      ids.push_back(static_cast<std::uint32_t>(v));
-    }
-  ones.assign(pts.size(), 1.0);
-  const std::size_t P = pts.size();
-  const detail::point_grid grid = detail::make_point_grid(pts, vals, ones, ids, 2.0 * sigma.back());
+  const std::vector<char> used = detail::referenced_vertices(m);
+  const detail::point_grid grid = detail::referenced_point_grid(m, used, out.curvature, 2.0 * sigma.back());
+  const std::size_t P = grid.x.size();
   const std::vector<double> avg =
       opt.method == saliency_method::exact
           ? detail::exact_gaussian_averages(exec, grid, sigma, opt.grain)

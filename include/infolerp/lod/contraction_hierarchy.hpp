@@ -1,0 +1,477 @@
+#pragma once
+// Saliency-weighted quadric simplification into a contraction hierarchy (salient-clustering
+// paper §III.C, with the bookkeeping §IV.A's neighbour matching needs).
+//
+// Garland–Heckbert quadrics: each triangle's plane quadric, scaled by its area and by the
+// weighting map's value at each corner (weighting_map.hpp), is added to that corner's vertex;
+// mesh-boundary edges add a perpendicular plane (boundary_weight × squared edge length) to
+// both ends. Contractions are half-edge collapses u → v (u is removed, v keeps its position),
+// so every level of detail indexes the original vertices and the per-view pass only remaps
+// indices. Cost of u → v: (Q_u + Q_v)(p_v); pairs are ordered globally over the whole mesh
+// (connectivity across cluster borders is kept) by (cost, u, v) in a binary heap with lazy
+// deletion; when the heap runs dry the remaining edges are queued once more, until a round
+// performs no contraction.
+// A contraction is refused when it would: create a non-manifold edge or a duplicate triangle
+// (link condition: the common neighbours of u and v are exactly the vertices opposite edge uv),
+// flip or flatten a triangle (the angle between old and new normal must stay below
+// acos(min_normal_cos), so the dot product stays positive), or move a
+// mesh-boundary vertex off its boundary (a boundary u may only move along a boundary edge).
+// Cluster-local phase (cluster_local_first): with one global order, a cluster performs a prefix
+// of it, so depending on one late contraction of a neighbour means performing all of that
+// neighbour's earlier ones; near the coarse end every contraction depends on late neighbours,
+// and neighbour matching would drag every cluster to the coarsest one. So the build first
+// performs only contractions whose removed vertex, target and both 1-rings are all owned by one
+// cluster: these depend on nothing outside it, and clusters simplify independently until only
+// bands along their borders are left; then contractions run over the whole mesh as above.
+// Simplification stops at the backstop: backstop × V vertices left (the paper stops at 1%).
+//
+// Hierarchy: for contraction i (its global order): removed[i], target[i], and parent[i], the
+// order of the last contraction it depends on: the latest contraction that changed the
+// triangle fan of u, v or any neighbour of u or v (none: no_parent). Each contraction belongs
+// to the cluster owning its removed vertex (the cluster of the vertex's lowest-index triangle);
+// a cluster's capacity is the number of contractions it owns, its local capacity those of the
+// cluster-local phase (what view_dependent_lod hands distribute_contractions). For neighbour
+// matching, each contraction whose dependencies include contractions owned by other clusters
+// records, per such cluster, the latest of them (cross_dependency):
+// dependencies inside the own cluster are met by construction (a cluster always performs a
+// prefix of its contractions in global order).
+//
+// Preconditions: an edge-manifold mesh (checked), finite positions (checked).
+// Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
+// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
+// cross-cluster dependency, 12 per triangle (the cluster-ordered index buffer), 4 per vertex.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include "infolerp/core/mesh_traits.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/mesh/curvature.hpp"
+#include "infolerp/mesh/topology.hpp"
+
+namespace infolerp {
+
+inline constexpr std::uint32_t no_parent = invalid_id;
+
+struct simplification_options {
+  double backstop = 0.01;         // stop when this fraction of the vertices is left, in [0, 1]
+  double boundary_weight = 10.0;  // weight of the planes that hold mesh-boundary edges, >= 0
+  double min_normal_cos = 0.0;    // a triangle's normal may turn by at most acos of this, in [0, 1)
+  bool cluster_local_first = true;  // first only contractions whose 2-ring lies in one cluster (see above)
+};
+
+struct cross_dependency {
+  std::uint32_t order;    // a contraction owned by the listing cluster
+  std::uint32_t cluster;  // another cluster
+  std::uint32_t needs;    // the latest contraction of `cluster` that `order` depends on
+};
+
+struct contraction_hierarchy {
+  // Per contraction, in global order.
+  std::vector<std::uint32_t> removed, target, parent, owner;
+  std::vector<std::uint8_t> faces_removed;  // triangles the contraction removes (1 on a boundary edge, 2 inside)
+  std::vector<float> error;                 // its weighted quadric cost (Q_u + Q_v)(p_v)
+  // Per vertex: the order of the contraction removing it, or invalid_id.
+  std::vector<std::uint32_t> removal_order;
+  // Per cluster (CSR): owned contractions ascending.
+  std::vector<std::uint32_t> cluster_offsets, cluster_contractions;
+  // Per cluster (CSR): dependencies on other clusters' contractions, ascending by order.
+  std::vector<std::uint32_t> cross_offsets;
+  std::vector<cross_dependency> cross;
+  // The mesh's triangles grouped by cluster (index buffer order, original vertex ids) and the
+  // triangle offsets of each cluster.
+  std::vector<std::uint32_t> indices, triangle_offsets;
+  std::uint32_t vertex_count = 0, cluster_count = 0;
+  std::uint32_t local_contractions = 0;  // the first ones, that touch only their own cluster's vertices
+
+  [[nodiscard]] std::size_t contraction_count() const { return removed.size(); }
+  [[nodiscard]] std::size_t triangle_count() const { return indices.size() / 3; }
+  [[nodiscard]] std::uint64_t capacity(std::uint32_t c) const { return cluster_offsets[c + 1] - cluster_offsets[c]; }
+  // Contractions of cluster c in the cluster-local phase (those with order < local_contractions).
+  [[nodiscard]] std::uint64_t local_capacity(std::uint32_t c) const {
+    const auto b = cluster_contractions.begin() + cluster_offsets[c], e = cluster_contractions.begin() + cluster_offsets[c + 1];
+    return static_cast<std::uint64_t>(std::lower_bound(b, e, local_contractions) - b);
+  }
+  [[nodiscard]] std::size_t memory_bytes() const {
+    return 4 * (removed.size() + target.size() + parent.size() + owner.size() + error.size() + removal_order.size() +
+                cluster_offsets.size() + cluster_contractions.size() + cross_offsets.size() + 3 * cross.size() +
+                indices.size() + triangle_offsets.size()) +
+           faces_removed.size();
+  }
+};
+
+namespace detail {
+
+struct quadric {  // symmetric 4×4: a (xx xy xz yy yz zz), b (x y z), c
+  double a[6] = {}, b[3] = {}, c = 0.0;
+  void add_plane(const glm::dvec3& n, double d, double w) {
+    a[0] += w * n.x * n.x, a[1] += w * n.x * n.y, a[2] += w * n.x * n.z;
+    a[3] += w * n.y * n.y, a[4] += w * n.y * n.z, a[5] += w * n.z * n.z;
+    b[0] += w * n.x * d, b[1] += w * n.y * d, b[2] += w * n.z * d, c += w * d * d;
+  }
+  quadric& operator+=(const quadric& q) {
+    for (int k = 0; k < 6; ++k) a[k] += q.a[k];
+    for (int k = 0; k < 3; ++k) b[k] += q.b[k];
+    c += q.c;
+    return *this;
+  }
+  [[nodiscard]] double eval(const glm::dvec3& p) const {
+    const double e = p.x * (a[0] * p.x + 2.0 * (a[1] * p.y + a[2] * p.z + b[0])) +
+                     p.y * (a[3] * p.y + 2.0 * (a[4] * p.z + b[1])) + p.z * (a[5] * p.z + 2.0 * b[2]) + c;
+    return std::max(0.0, e);
+  }
+};
+
+inline double sum_eval(const quadric& q0, const quadric& q1, const glm::dvec3& p) {
+  quadric q = q0;
+  q += q1;
+  return q.eval(p);
+}
+
+struct collapse_entry {
+  double cost;
+  std::uint32_t u, v, ver_u, ver_v;
+  bool operator>(const collapse_entry& o) const {
+    if (cost != o.cost) return cost > o.cost;
+    if (u != o.u) return u > o.u;
+    return v > o.v;
+  }
+};
+
+// The mutable mesh of the build: triangles with per-vertex corner lists (singly linked, dead
+// triangles unlinked lazily), quadrics and heap versions.
+class collapse_mesh {
+ public:
+  static constexpr std::uint32_t nil = invalid_id;
+  std::vector<glm::dvec3> pos;
+  std::vector<glm::uvec3> tri;
+  std::vector<char> tri_alive, alive, boundary;
+  std::vector<std::uint32_t> head, next, version, stamp, last_touch;
+  std::vector<quadric> q;
+  std::uint32_t stamp_now = 0;
+  std::vector<std::uint32_t> ring_u, ring_v;
+
+  // Calls f(t) for every live triangle of x, unlinking dead ones on the way.
+  template <class F>
+  void for_each_triangle(std::uint32_t x, F&& f) {
+    std::uint32_t* link = &head[x];
+    while (*link != nil) {
+      const std::uint32_t c = *link;
+      if (!tri_alive[c / 3]) {
+        *link = next[c];
+        continue;
+      }
+      f(c / 3);
+      link = &next[c];
+    }
+  }
+  // Distinct neighbours of x into out, each marked with a fresh stamp.
+  void ring(std::uint32_t x, std::vector<std::uint32_t>& out) {
+    out.clear();
+    const std::uint32_t s = ++stamp_now;
+    for_each_triangle(x, [&](std::uint32_t t) {
+      for (int j = 0; j < 3; ++j) {
+        const std::uint32_t y = tri[t][j];
+        if (y != x && stamp[y] != s) stamp[y] = s, out.push_back(y);
+      }
+    });
+  }
+  std::uint32_t shared_triangles(std::uint32_t u, std::uint32_t v, std::uint32_t opp[2]) {
+    std::uint32_t k = 0;
+    for_each_triangle(u, [&](std::uint32_t t) {
+      const glm::uvec3 f = tri[t];
+      if (f.x != v && f.y != v && f.z != v) return;
+      if (k < 2) opp[k] = f.x != u && f.x != v ? f.x : (f.y != u && f.y != v ? f.y : f.z);
+      ++k;
+    });
+    return k;
+  }
+  // The §III.C validity tests for u → v (see the top of the file). Leaves ring(u) in ring_u,
+  // ring(v) in ring_v.
+  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
+    std::uint32_t opp[2] = {nil, nil};
+    const std::uint32_t k = shared_triangles(u, v, opp);
+    if (k == 0 || k > 2) return false;
+    if (boundary[u] && !(boundary[v] && k == 1)) return false;
+    ring(u, ring_u);
+    ring(v, ring_v);
+    const std::uint32_t sv = stamp_now;  // ring(v) carries this stamp
+    // Link condition: a common neighbour must be opposite the edge.
+    for (std::uint32_t x : ring_u)
+      if (x != v && stamp[x] == sv && x != opp[0] && x != opp[1]) return false;
+    bool ok = true;
+    const glm::dvec3 pv = pos[v];
+    for_each_triangle(u, [&](std::uint32_t t) {
+      if (!ok) return;
+      const glm::uvec3 f = tri[t];
+      if (f.x == v || f.y == v || f.z == v) return;
+      glm::dvec3 p[3] = {pos[f.x], pos[f.y], pos[f.z]};
+      const glm::dvec3 n0 = glm::cross(p[1] - p[0], p[2] - p[0]);
+      for (int j = 0; j < 3; ++j)
+        if (f[j] == u) p[j] = pv;
+      const glm::dvec3 n1 = glm::cross(p[1] - p[0], p[2] - p[0]);
+      if (!(glm::dot(n0, n1) > min_cos * glm::length(n0) * glm::length(n1))) ok = false;
+      // A duplicate triangle (v, a, b) would appear when v already has one on a and b.
+      std::uint32_t a = nil, b = nil;
+      for (int j = 0; j < 3; ++j)
+        if (f[j] != u) (a == nil ? a : b) = f[j];
+      if (k == 2 && (a == opp[0] || a == opp[1]) && (b == opp[0] || b == opp[1]))
+        for_each_triangle(v, [&](std::uint32_t s) {
+          const glm::uvec3 g = tri[s];
+          const bool has_a = g.x == a || g.y == a || g.z == a, has_b = g.x == b || g.y == b || g.z == b;
+          if (has_a && has_b) ok = false;
+        });
+    });
+    return ok;
+  }
+  // Performs u → v; returns the triangles removed. ring_u must hold ring(u).
+  std::uint8_t collapse(std::uint32_t u, std::uint32_t v) {
+    std::uint8_t removed = 0;
+    std::uint32_t last = nil;
+    for_each_triangle(u, [&](std::uint32_t t) {
+      glm::uvec3& f = tri[t];
+      if (f.x == v || f.y == v || f.z == v) {
+        tri_alive[t] = 0;
+        ++removed;
+        return;
+      }
+      for (int j = 0; j < 3; ++j)
+        if (f[j] == u) f[j] = v, last = 3 * t + static_cast<std::uint32_t>(j);
+    });
+    // Splice u's (live) corners in front of v's.
+    if (last != nil) {
+      // Walk to the end of u's list: dead entries may remain after `last`, so find the tail.
+      std::uint32_t c = head[u];
+      while (next[c] != nil) c = next[c];
+      next[c] = head[v];
+      head[v] = head[u];
+    }
+    head[u] = nil;
+    alive[u] = 0;
+    q[v] += q[u];
+    ++version[u], ++version[v];
+    return removed;
+  }
+};
+
+}  // namespace detail
+
+// Builds the hierarchy. weights: 3 per triangle (corner order; weighting_map.hpp), finite and
+// >= 0. cluster: one id < cluster_count per triangle. Errors: mesh errors (empty, index out of
+// range, non-finite position), a non-manifold edge (names the edge's first vertex), weights or
+// cluster of the wrong size (bad_size), a negative or non-finite weight (names the corner),
+// a cluster id out of range (names the triangle), options outside their ranges.
+// Serial (the global order is inherently sequential); pure.
+template <class M>
+result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<const double> weights,
+                                                          std::span<const std::uint32_t> cluster,
+                                                          std::uint32_t cluster_count,
+                                                          const simplification_options& opt = {}) {
+  static_assert(check_mesh<M>());
+  if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
+  const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
+  if (weights.size() != 3 * nt)
+    return make_error(errc::bad_size, weights.size(), "weights has ", weights.size(), " values for ", 3 * nt,
+                      " triangle corners");
+  if (cluster.size() != nt)
+    return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
+  for (std::size_t k = 0; k < weights.size(); ++k)
+    if (!(weights[k] >= 0.0) || !std::isfinite(weights[k]))
+      return make_error(errc::non_finite, k, "weight of corner ", k % 3, " of triangle ", k / 3, " is ", weights[k],
+                        "; must be finite and >= 0");
+  for (std::size_t t = 0; t < nt; ++t)
+    if (cluster[t] >= cluster_count)
+      return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
+                        cluster_count);
+  if (!(opt.backstop >= 0.0 && opt.backstop <= 1.0))
+    return make_error(errc::bad_parameter, no_element, "backstop ", opt.backstop, " must be in [0, 1]");
+  if (!(opt.min_normal_cos >= 0.0 && opt.min_normal_cos < 1.0))
+    return make_error(errc::bad_parameter, no_element, "min_normal_cos ", opt.min_normal_cos, " must be in [0, 1)");
+  if (!(opt.boundary_weight >= 0.0) || !std::isfinite(opt.boundary_weight))
+    return make_error(errc::bad_parameter, no_element, "boundary_weight ", opt.boundary_weight, " must be >= 0 and finite");
+  auto topo = build_topology(m);
+  if (!topo.ok()) return topo.error();
+  for (std::size_t e = 0; e < topo->edge_count(); ++e)
+    if (topo->is_non_manifold_edge(e))
+      return make_error(errc::non_manifold_edge, topo->edges[e].x, "edge (", topo->edges[e].x, ", ", topo->edges[e].y,
+                        ") has ", topo->edge_valence(e), " triangles");
+
+  detail::collapse_mesh cm;
+  cm.pos.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = glm::dvec3(mesh_position(m, v));
+  cm.tri.resize(nt);
+  cm.tri_alive.assign(nt, 1);
+  cm.alive.assign(nv, 0);
+  cm.boundary.assign(nv, 0);
+  cm.head.assign(nv, detail::collapse_mesh::nil);
+  cm.next.assign(3 * nt, detail::collapse_mesh::nil);
+  cm.version.assign(nv, 0);
+  cm.stamp.assign(nv, 0);
+  cm.last_touch.assign(nv, no_parent);
+  cm.q.assign(nv, {});
+  std::vector<std::uint32_t> owner(nv, invalid_id);
+  for (std::size_t t = nt; t-- > 0;) {
+    const glm::uvec3 f = mesh_triangle(m, t);
+    cm.tri[t] = f;
+    if (f.x == f.y || f.y == f.z || f.x == f.z) {
+      cm.tri_alive[t] = 0;  // a repeated index draws nothing; it never joins a corner list
+      continue;
+    }
+    for (int j = 0; j < 3; ++j) {
+      const std::uint32_t c = 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(j);
+      cm.next[c] = cm.head[f[j]];
+      cm.head[f[j]] = c;
+      cm.alive[f[j]] = 1;
+      owner[f[j]] = cluster[t];  // last write wins: the lowest-index triangle
+    }
+    const glm::dvec3 p0 = cm.pos[f.x], p1 = cm.pos[f.y], p2 = cm.pos[f.z];
+    const glm::dvec3 n2 = glm::cross(p1 - p0, p2 - p0);
+    const double len = glm::length(n2);
+    if (!(len > 0.0)) continue;
+    const glm::dvec3 n = n2 / len;
+    const double d = -glm::dot(n, p0), area = 0.5 * len;
+    for (int j = 0; j < 3; ++j) cm.q[f[j]].add_plane(n, d, area * weights[3 * t + static_cast<std::size_t>(j)]);
+  }
+  // Boundary planes.
+  for (std::size_t e = 0; e < topo->edge_count(); ++e) {
+    if (!topo->is_boundary_edge(e)) continue;
+    const glm::uvec2 ab = topo->edges[e];
+    cm.boundary[ab.x] = cm.boundary[ab.y] = 1;
+    const std::uint32_t t = topo->faces_of_edge(e)[0];
+    const glm::uvec3 f = cm.tri[t];
+    const glm::dvec3 fn = glm::cross(cm.pos[f.y] - cm.pos[f.x], cm.pos[f.z] - cm.pos[f.x]);
+    const glm::dvec3 ev = cm.pos[ab.y] - cm.pos[ab.x];
+    const glm::dvec3 pn = glm::cross(ev, fn);
+    const double len = glm::length(pn);
+    if (!(len > 0.0)) continue;
+    const glm::dvec3 n = pn / len;
+    const double d = -glm::dot(n, cm.pos[ab.x]);
+    const double w = opt.boundary_weight * glm::dot(ev, ev) * (weights[3 * t] + weights[3 * t + 1] + weights[3 * t + 2]) / 3.0;
+    cm.q[ab.x].add_plane(n, d, w);
+    cm.q[ab.y].add_plane(n, d, w);
+  }
+
+  std::size_t live = 0;
+  for (std::size_t v = 0; v < nv; ++v) live += cm.alive[v] ? 1 : 0;
+  const auto floor_count = static_cast<std::size_t>(std::ceil(opt.backstop * static_cast<double>(live)));
+
+  contraction_hierarchy h;
+  h.vertex_count = static_cast<std::uint32_t>(nv);
+  h.cluster_count = cluster_count;
+  h.removal_order.assign(nv, invalid_id);
+  std::vector<std::pair<std::uint32_t, cross_dependency>> crossing;  // (owner, entry), ascending order
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> dep_scratch;  // (cluster, order) of dependencies
+
+  std::vector<detail::collapse_entry> heap;
+  auto push = [&](std::uint32_t u, std::uint32_t v) {
+    heap.push_back({detail::sum_eval(cm.q[u], cm.q[v], cm.pos[v]), u, v, cm.version[u], cm.version[v]});
+    std::push_heap(heap.begin(), heap.end(), std::greater<>{});
+  };
+  auto fill = [&] {
+    heap.clear();
+    for (std::size_t t = 0; t < nt; ++t) {
+      if (!cm.tri_alive[t]) continue;
+      const glm::uvec3 f = cm.tri[t];
+      for (int j = 0; j < 3; ++j) {
+        const std::uint32_t a = f[j], b = f[(j + 1) % 3];
+        // Each interior edge is seen from two triangles; queue it from the one where a < b.
+        heap.push_back({detail::sum_eval(cm.q[a], cm.q[b], cm.pos[b]), a, b, cm.version[a], cm.version[b]});
+        heap.push_back({detail::sum_eval(cm.q[a], cm.q[b], cm.pos[a]), b, a, cm.version[b], cm.version[a]});
+      }
+    }
+    std::make_heap(heap.begin(), heap.end(), std::greater<>{});
+  };
+  fill();
+  bool progress_since_fill = false, local_phase = opt.cluster_local_first;
+  auto local_to_cluster = [&](std::uint32_t c) {
+    for (std::uint32_t x : cm.ring_u) if (owner[x] != c) return false;
+    for (std::uint32_t x : cm.ring_v) if (owner[x] != c) return false;
+    return true;
+  };
+  while (live > floor_count) {
+    if (heap.empty()) {
+      if (!progress_since_fill && !local_phase) break;
+      if (!progress_since_fill) {
+        local_phase = false;
+        h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
+      }
+      progress_since_fill = false;
+      fill();
+      continue;
+    }
+    std::pop_heap(heap.begin(), heap.end(), std::greater<>{});
+    const detail::collapse_entry e = heap.back();
+    heap.pop_back();
+    if (!cm.alive[e.u] || !cm.alive[e.v] || cm.version[e.u] != e.ver_u || cm.version[e.v] != e.ver_v) continue;
+    if (!cm.can_collapse(e.u, e.v, opt.min_normal_cos)) continue;
+    if (local_phase && !local_to_cluster(owner[e.u])) continue;
+    // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
+    const auto order = static_cast<std::uint32_t>(h.removed.size());
+    std::uint32_t parent = no_parent;
+    dep_scratch.clear();
+    auto note = [&](std::uint32_t x) {
+      const std::uint32_t j = cm.last_touch[x];
+      if (j == no_parent) return;
+      parent = parent == no_parent ? j : std::max(parent, j);
+      if (h.owner[j] != owner[e.u]) dep_scratch.push_back({h.owner[j], j});
+    };
+    note(e.u), note(e.v);
+    for (std::uint32_t x : cm.ring_u) note(x);
+    for (std::uint32_t x : cm.ring_v) note(x);
+    std::sort(dep_scratch.begin(), dep_scratch.end());
+    for (std::size_t k = 0; k < dep_scratch.size(); ++k)  // the latest per cluster
+      if (k + 1 == dep_scratch.size() || dep_scratch[k + 1].first != dep_scratch[k].first)
+        crossing.push_back({owner[e.u], {order, dep_scratch[k].first, dep_scratch[k].second}});
+    const std::uint8_t gone = cm.collapse(e.u, e.v);
+    h.removed.push_back(e.u), h.target.push_back(e.v), h.parent.push_back(parent), h.owner.push_back(owner[e.u]);
+    h.faces_removed.push_back(gone);
+    h.error.push_back(static_cast<float>(e.cost));
+    h.removal_order[e.u] = order;
+    cm.last_touch[e.v] = order;
+    for (std::uint32_t x : cm.ring_u) cm.last_touch[x] = order;
+    --live;
+    progress_since_fill = true;
+    cm.ring(e.v, cm.ring_v);
+    for (std::uint32_t x : cm.ring_v) push(e.v, x), push(x, e.v);
+  }
+
+  if (local_phase) h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
+  // Per-cluster contraction lists and cross-cluster dependencies (counting sorts, stable).
+  h.cluster_offsets.assign(cluster_count + 1, 0);
+  for (std::uint32_t c : h.owner) ++h.cluster_offsets[c + 1];
+  for (std::uint32_t c = 0; c < cluster_count; ++c) h.cluster_offsets[c + 1] += h.cluster_offsets[c];
+  h.cluster_contractions.resize(h.owner.size());
+  {
+    std::vector<std::uint32_t> cursor(h.cluster_offsets.begin(), h.cluster_offsets.end() - 1);
+    for (std::uint32_t i = 0; i < h.owner.size(); ++i) h.cluster_contractions[cursor[h.owner[i]]++] = i;
+  }
+  h.cross_offsets.assign(cluster_count + 1, 0);
+  for (const auto& x : crossing) ++h.cross_offsets[x.first + 1];
+  for (std::uint32_t c = 0; c < cluster_count; ++c) h.cross_offsets[c + 1] += h.cross_offsets[c];
+  h.cross.resize(crossing.size());
+  {
+    std::vector<std::uint32_t> cursor(h.cross_offsets.begin(), h.cross_offsets.end() - 1);
+    for (const auto& x : crossing) h.cross[cursor[x.first]++] = x.second;
+  }
+  // Index buffer grouped by cluster (stable: triangle order inside a cluster is kept).
+  h.triangle_offsets.assign(cluster_count + 1, 0);
+  for (std::size_t t = 0; t < nt; ++t) ++h.triangle_offsets[cluster[t] + 1];
+  for (std::uint32_t c = 0; c < cluster_count; ++c) h.triangle_offsets[c + 1] += h.triangle_offsets[c];
+  h.indices.resize(3 * nt);
+  {
+    std::vector<std::uint32_t> cursor(h.triangle_offsets.begin(), h.triangle_offsets.end() - 1);
+    for (std::size_t t = 0; t < nt; ++t) {
+      const glm::uvec3 f = mesh_triangle(m, t);
+      const std::uint32_t k = cursor[cluster[t]]++;
+      h.indices[3 * k] = f.x, h.indices[3 * k + 1] = f.y, h.indices[3 * k + 2] = f.z;
+    }
+  }
+  return h;
+}
+
+}  // namespace infolerp

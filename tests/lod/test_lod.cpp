@@ -1,0 +1,333 @@
+// Weighting map, contraction hierarchy, per-view selection and vertex contraction
+// (salient-clustering paper §III.C, §IV).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <random>
+#include <vector>
+#include <catch2/catch.hpp>
+#include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/vertex_contraction.hpp"
+#include "infolerp/lod/view_dependent_lod.hpp"
+#include "infolerp/lod/view_selection.hpp"
+#include "infolerp/lod/weighting_map.hpp"
+#include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
+#include "support/thread_pool.hpp"
+
+using namespace infolerp;
+
+namespace {
+
+// Clusters by the octant of the triangle centroid (8 ids, some possibly empty).
+std::vector<std::uint32_t> octant_clusters(const indexed_mesh& m) {
+  std::vector<std::uint32_t> c(m.triangle_count());
+  glm::dvec3 mid(0.0);
+  for (const auto& p : m.positions) mid += glm::dvec3(p);
+  mid /= static_cast<double>(m.positions.size());
+  for (std::size_t t = 0; t < c.size(); ++t) {
+    const glm::dvec3 x = triangle_centroid(corners(m, t)) - mid;
+    c[t] = (x.x > 0 ? 1u : 0u) | (x.y > 0 ? 2u : 0u) | (x.z > 0 ? 4u : 0u);
+  }
+  return c;
+}
+
+// Every undirected edge of the output has exactly two triangles, used once in each direction,
+// and no triangle repeats an index.
+bool closed_and_manifold(std::span<const std::uint32_t> idx) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  for (std::size_t k = 0; k < idx.size(); k += 3) {
+    if (idx[k] == idx[k + 1] || idx[k + 1] == idx[k + 2] || idx[k] == idx[k + 2]) return false;
+    for (int j = 0; j < 3; ++j) ++directed[{idx[k + static_cast<std::size_t>(j)], idx[k + static_cast<std::size_t>((j + 1) % 3)]}];
+  }
+  for (const auto& [e, n] : directed) {
+    if (n != 1) return false;
+    auto it = directed.find({e.second, e.first});
+    if (it == directed.end() || it->second != 1) return false;
+  }
+  return true;
+}
+
+bool applied(const contraction_hierarchy& h, std::span<const std::uint32_t> stop, std::uint32_t i) {
+  return i < stop[h.owner[i]];
+}
+
+// Brute-force reference of one frame: apply the chosen contractions in global order to a
+// per-vertex map, then remap the cluster-ordered triangles and drop degenerate ones.
+std::vector<std::uint32_t> reference_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop) {
+  std::vector<std::uint32_t> to(h.vertex_count);
+  for (std::uint32_t v = 0; v < h.vertex_count; ++v) to[v] = v;
+  for (std::uint32_t i = 0; i < h.contraction_count(); ++i)
+    if (applied(h, stop, i))
+      for (auto& x : to)
+        if (x == h.removed[i]) x = h.target[i];
+  std::vector<std::uint32_t> out;
+  for (std::size_t t = 0; t < h.triangle_count(); ++t) {
+    const std::uint32_t a = to[h.indices[3 * t]], b = to[h.indices[3 * t + 1]], c = to[h.indices[3 * t + 2]];
+    if (a != b && b != c && a != c) out.insert(out.end(), {a, b, c});
+  }
+  return out;
+}
+
+result<contraction_hierarchy> uniform_hierarchy(const indexed_mesh& m, std::span<const std::uint32_t> cl,
+                                                std::uint32_t count, double backstop) {
+  std::vector<double> w(3 * m.triangle_count(), 1.0);
+  return build_contraction_hierarchy(m, w, cl, count, {.backstop = backstop});
+}
+
+}  // namespace
+
+TEST_CASE("weighting map: amplification and smoothing on hand-made maps", "[lod]") {
+  std::vector<double> hand{5, 0, 9, 1, 8, 2, 7, 3, 6, 4};
+  amplify_weights(hand, 30.0, 100.0);  // 30th percentile of 0..9 (nearest rank 3) is 2
+  CHECK(hand == std::vector<double>{500, 0, 900, 1, 800, 200, 700, 300, 600, 400});
+
+  // Smoothing: one spike on a plane against the Gaussian ball average by brute force.
+  const indexed_mesh m = support::make_plane(10, 10, 1.0f);
+  std::vector<double> s(m.vertex_count(), 0.0);
+  s[60] = 1.0, s[3] = 0.5;
+  const double sigma = 0.08;
+  const std::vector<double> g = smooth_vertex_values(m, std::span<const double>(s), sigma);
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t x = 0; x < m.vertex_count(); ++x) {
+      const double d2 = glm::dot(glm::dvec3(m.positions[x] - m.positions[v]), glm::dvec3(m.positions[x] - m.positions[v]));
+      if (d2 > 4.0 * sigma * sigma) continue;
+      const double w = std::exp(-d2 / (2.0 * sigma * sigma));
+      num += w * s[x], den += w;
+    }
+    CHECK(g[v] == Approx(num / den).margin(1e-12));
+  }
+
+  // Without smoothing and amplification the map is eq. 4 itself.
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  std::vector<double> sal(m.vertex_count());
+  for (std::size_t k = 0; k < sal.size(); ++k) sal[k] = static_cast<double>(k % 7);
+  auto plain = weighting_map(m, sal, cl, 8, {.smoothing_scale = 0.0, .amplification = 1.0});
+  auto eq4 = cluster_localized_saliency(m, sal, cl, 8);
+  REQUIRE(plain.ok());
+  REQUIRE(eq4.ok());
+  CHECK(*plain == *eq4);
+  // Defaults: every corner is its smoothed eq. 4 value, ×100 at or above the 30th percentile.
+  auto full = weighting_map(m, sal, cl, 8);
+  REQUIRE(full.ok());
+  const std::vector<double> sm = smooth_vertex_values(m, std::span<const double>(sal), 3.0 * 0.003 * mesh_bounds(m).diagonal());
+  auto local = cluster_localized_saliency(m, std::span<const double>(sm), cl, 8);
+  REQUIRE(local.ok());
+  std::vector<double> sorted = *local;
+  std::sort(sorted.begin(), sorted.end());
+  const double alpha = sorted[static_cast<std::size_t>(std::ceil(0.3 * static_cast<double>(sorted.size()))) - 1];
+  for (std::size_t k = 0; k < sorted.size(); ++k) CHECK((*full)[k] == ((*local)[k] >= alpha ? 100.0 * (*local)[k] : (*local)[k]));
+}
+
+TEST_CASE("a plane of many triangles simplifies to two with zero error", "[lod]") {
+  const indexed_mesh m = support::make_plane(12, 9, 2.0f);
+  const std::vector<std::uint32_t> cl(m.triangle_count(), 0);
+  auto h = uniform_hierarchy(m, cl, 1, 0.0);
+  REQUIRE(h.ok());
+  std::uint32_t zero = 0;
+  while (zero < h->contraction_count() && h->error[zero] == 0.0f) ++zero;
+  const std::vector<std::uint32_t> stop{zero};
+  const auto idx = reference_indices(*h, stop);
+  REQUIRE(idx.size() == 6);
+  double area = 0.0;
+  for (std::size_t k = 0; k < idx.size(); k += 3) {
+    const glm::dvec3 a(m.positions[idx[k]]), b(m.positions[idx[k + 1]]), c(m.positions[idx[k + 2]]);
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    CHECK(n.z > 0.0);
+    area += 0.5 * glm::length(n);
+  }
+  CHECK(area == Approx(4.0).epsilon(1e-12));
+  for (std::uint32_t v : idx) CHECK(std::abs(std::abs(m.positions[v].x) - 1.0f) + std::abs(std::abs(m.positions[v].y) - 1.0f) == 0.0f);
+}
+
+TEST_CASE("a closed mesh stays closed at every budget; dependencies and budgets hold", "[lod]") {
+  const indexed_mesh m = support::make_torus(24, 12, 1.0f, 0.35f);
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  auto h = uniform_hierarchy(m, cl, 8, 0.01);
+  REQUIRE(h.ok());
+  REQUIRE(h->contraction_count() > m.vertex_count() / 2);
+  contraction_workspace w = make_contraction_workspace(*h, 16);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h));
+  std::vector<index_range> ranges(8);
+  std::vector<std::uint32_t> stop(8);
+
+  SECTION("global prefixes from 0 to the backstop") {
+    for (std::uint32_t k = 0; k <= h->contraction_count(); k += 7) {
+      std::fill(stop.begin(), stop.end(), k);
+      auto n = contract_indices(*h, stop, w, out, ranges);
+      REQUIRE(n.ok());
+      const std::span<const std::uint32_t> got(out.data(), *n);
+      INFO("prefix " << k);
+      CHECK(closed_and_manifold(got));
+      std::size_t removed = 0;
+      for (std::uint32_t i = 0; i < k; ++i) removed += h->faces_removed[i];
+      CHECK(*n == 3 * (m.triangle_count() - removed));
+    }
+  }
+  SECTION("clusters at very different budgets, with neighbour matching") {
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 60; ++trial) {
+      std::vector<std::uint64_t> budget(8);
+      for (std::uint32_t c = 0; c < 8; ++c) {
+        const auto cap = h->capacity(c);
+        const int mode = static_cast<int>(rng() % 3);
+        budget[c] = mode == 0 ? 0 : (mode == 1 ? cap : rng() % (cap + 1));
+      }
+      REQUIRE(stop_points_from_budgets(*h, budget, stop).ok());
+      for (std::uint32_t c = 0; c < 8; ++c) CHECK(applied_count(*h, c, stop[c]) == budget[c]);
+      match_neighbours(*h, stop);
+      for (std::uint32_t c = 0; c < 8; ++c) CHECK(applied_count(*h, c, stop[c]) >= budget[c]);
+      // No contraction before its dependencies.
+      for (std::uint32_t i = 0; i < h->contraction_count(); ++i)
+        if (applied(*h, stop, i) && h->parent[i] != no_parent) REQUIRE(applied(*h, stop, h->parent[i]));
+      auto n = contract_indices(*h, stop, w, out, ranges);
+      REQUIRE(n.ok());
+      const std::span<const std::uint32_t> got(out.data(), *n);
+      CHECK(closed_and_manifold(got));
+      // No contracted vertex referenced; the output equals the brute-force reference.
+      for (std::uint32_t v : got) {
+        const std::uint32_t i = h->removal_order[v];
+        CHECK((i == invalid_id || !applied(*h, stop, i)));
+      }
+      CHECK(std::vector<std::uint32_t>(got.begin(), got.end()) == reference_indices(*h, stop));
+      // Ranges tile the output in cluster order.
+      std::size_t at = 0;
+      for (std::uint32_t c = 0; c < 8; ++c) {
+        if (ranges[c].count) CHECK(ranges[c].first == at);
+        at += ranges[c].count;
+      }
+      CHECK(at == *n);
+    }
+  }
+}
+
+TEST_CASE("vertex contraction: identical bits for any executor", "[lod]") {
+  const indexed_mesh m = support::make_icosphere(3);
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  auto h = uniform_hierarchy(m, cl, 8, 0.01);
+  REQUIRE(h.ok());
+  std::vector<std::uint32_t> stop{50, 400, 0, 90000, 200, 600, 10, 300};
+  match_neighbours(*h, stop);
+  contraction_workspace w1 = make_contraction_workspace(*h, 7), w2 = make_contraction_workspace(*h, 7);
+  std::vector<std::uint32_t> a(contracted_index_bound(*h)), b(a.size());
+  std::vector<index_range> ra(8), rb(8);
+  auto na = contract_indices(*h, stop, w1, a, ra);
+  auto nb = contract_indices(*h, stop, w2, b, rb, support::thread_pool_executor(4));
+  REQUIRE(na.ok());
+  REQUIRE(nb.ok());
+  CHECK(*na == *nb);
+  CHECK(a == b);
+  for (std::size_t c = 0; c < 8; ++c) CHECK((ra[c].first == rb[c].first && ra[c].count == rb[c].count));
+}
+
+TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
+  const indexed_mesh m = support::make_icosphere(3);
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  std::vector<double> sal(m.vertex_count());
+  for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 1.0 + 0.5 * std::sin(3.0 * m.positions[v].x);
+  auto wm = weighting_map(m, sal, cl, 8);
+  REQUIRE(wm.ok());
+  auto h = build_contraction_hierarchy(m, *wm, cl, 8);
+  REQUIRE(h.ok());
+  auto table = compute_cluster_attributes(m, sal, cl, 8);
+  REQUIRE(table.ok());
+  auto lod = view_dependent_lod::create(*h, *table);
+  REQUIRE(lod.ok());
+  std::vector<std::uint32_t> out(contracted_index_bound(*h));
+  std::vector<index_range> ranges(8);
+  REQUIRE(h->local_contractions > 100);
+  REQUIRE(h->local_contractions < h->contraction_count());
+  for (std::uint64_t r : {std::uint64_t{0}, std::uint64_t{100}, std::uint64_t{h->local_contractions}, lod->capacity() / 2,
+                          lod->capacity() - 3, lod->capacity()}) {
+    auto st = lod->frame(glm::dvec3(0.3, -2.0, 4.0), r, out, ranges);
+    REQUIRE(st.ok());
+    CHECK(st->budgeted == r);  // eq. 9 spends exactly R_global
+    CHECK(st->applied == r);   // and the local phase needs no matching: budgets honoured exactly
+    std::uint64_t sum = 0;
+    for (std::uint32_t c = 0; c < 8; ++c) {
+      CHECK(lod->budgets()[c] <= h->capacity(c));
+      if (r <= h->local_contractions) CHECK(lod->budgets()[c] <= h->local_capacity(c));
+      sum += lod->budgets()[c];
+    }
+    CHECK(sum == r);
+    std::size_t removed = 0;  // the triangle count follows from the applied contractions
+    for (std::uint32_t i = 0; i < h->contraction_count(); ++i)
+      if (i < lod->stop_points()[h->owner[i]]) removed += h->faces_removed[i];
+    CHECK(st->indices == 3 * (m.triangle_count() - removed));
+    CHECK(closed_and_manifold(std::span<const std::uint32_t>(out.data(), st->indices)));
+  }
+  // Bad input.
+  CHECK(lod->frame(glm::dvec3(0.0, 0.0, 5.0), lod->capacity() + 1, out, ranges).error().code() == errc::bad_parameter);
+  CHECK(lod->frame(glm::dvec3(std::nan(""), 0.0, 5.0), 10, out, ranges).error().code() == errc::bad_parameter);
+  {  // a camera inside a one-cluster sphere
+    const std::vector<std::uint32_t> one(m.triangle_count(), 0);
+    auto h1 = uniform_hierarchy(m, one, 1, 0.01);
+    auto t1 = compute_cluster_attributes(m, sal, one, 1);
+    REQUIRE(h1.ok());
+    REQUIRE(t1.ok());
+    auto lod1 = view_dependent_lod::create(*h1, *t1);
+    REQUIRE(lod1.ok());
+    std::vector<index_range> r1(1);
+    auto inside = lod1->frame(glm::dvec3(0.1, 0.0, 0.0), 10, out, r1);
+    CHECK(inside.error().code() == errc::bad_parameter);
+    CHECK(lod1->frame(glm::dvec3(0.0, 0.0, 3.0), 10, out, r1).ok());
+  }
+  std::vector<std::uint32_t> small(out.size() - 1);
+  CHECK(lod->frame(glm::dvec3(0.0, 0.0, 5.0), 10, small, ranges).error().code() == errc::bad_size);
+  std::vector<std::uint64_t> over(8, 0);
+  over[3] = h->capacity(3) + 1;
+  std::vector<std::uint32_t> stop(8);
+  const status s = stop_points_from_budgets(*h, over, stop);
+  CHECK(s.code() == errc::bad_parameter);
+  CHECK(s.element() == 3);
+  std::vector<double> w(3 * m.triangle_count(), 1.0);
+  w[5] = -1.0;
+  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().code() == errc::non_finite);
+  w[5] = std::nan("");
+  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().element() == 5);
+  w.pop_back();
+  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().code() == errc::bad_size);
+  std::vector<double> bad_sal = sal;
+  bad_sal[2] = -0.5;
+  CHECK(weighting_map(m, bad_sal, cl, 8).error().code() == errc::non_finite);
+  CHECK(weighting_map(m, sal, cl, 8, {.amplify_percentile = 101.0}).error().code() == errc::bad_parameter);
+}
+
+TEST_CASE("real meshes: hierarchy to the backstop stays manifold", "[lod][real]") {
+  for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) {
+    auto m = support::load_mesh(support::cgal_mesh(name));
+    REQUIRE(m.ok());
+    auto sal = compute_saliency(*m);
+    REQUIRE(sal.ok());
+    auto clusters = salient_clustering(*m, sal->saliency, {.clusters = 10});
+    REQUIRE(clusters.ok());
+    auto wm = weighting_map(*m, sal->saliency, clusters->cluster, clusters->count);
+    REQUIRE(wm.ok());
+    auto h = build_contraction_hierarchy(*m, *wm, clusters->cluster, clusters->count);
+    REQUIRE(h.ok());
+    INFO(name << ": " << h->contraction_count() << " contractions of " << m->vertex_count() << " vertices");
+    CHECK(h->contraction_count() + static_cast<std::size_t>(0.02 * static_cast<double>(m->vertex_count())) >= m->vertex_count());
+    auto table = compute_cluster_attributes(*m, sal->saliency, clusters->cluster, clusters->count);
+    REQUIRE(table.ok());
+    auto lod = view_dependent_lod::create(*h, *table);
+    REQUIRE(lod.ok());
+    std::vector<std::uint32_t> out(contracted_index_bound(*h));
+    std::vector<index_range> ranges(clusters->count);
+    const bounding_box box = mesh_bounds(*m);
+    auto st = lod->frame(box.center() + glm::dvec3(0.0, 0.0, 2.0 * box.diagonal()), lod->capacity() * 95 / 100, out, ranges);
+    if (!st.ok()) FAIL(st.error().message());
+    // Boundary edges of the input stay the only boundary edges: count edges used once.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> und;
+    for (std::size_t k = 0; k < st->indices; k += 3)
+      for (int j = 0; j < 3; ++j) {
+        std::uint32_t a = out[k + static_cast<std::size_t>(j)], b = out[k + static_cast<std::size_t>((j + 1) % 3)];
+        ++und[{std::min(a, b), std::max(a, b)}];
+      }
+    std::size_t non_manifold = 0;
+    for (const auto& [e, n] : und) non_manifold += n > 2 ? 1 : 0;
+    CHECK(non_manifold == 0);
+  }
+}
