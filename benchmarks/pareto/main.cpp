@@ -9,9 +9,9 @@ int main(int argc, char** argv) {
     const char* name;
     sub_fn fn;
   };
-  const sub subs[] = {{"refine", &pareto_refine}, {"upsample", &pareto_upsample}};
+  const sub subs[] = {{"refine", &pareto_refine}, {"upsample", &pareto_upsample}, {"visibility", &pareto_visibility}};
   for (const sub& s : subs)
     if (argc >= 2 && std::strcmp(argv[1], s.name) == 0 && s.fn != nullptr) return s.fn(argc - 1, argv + 1);
-  std::fprintf(stderr, "usage: infolerp_pareto refine|upsample [options]\n");
+  std::fprintf(stderr, "usage: infolerp_pareto refine|upsample|visibility [options]\n");
   return 2;
 }
