@@ -15,6 +15,8 @@
 // Rows: option=default (n = 2, 64 viewpoints), option=reference (n = 4), then one row per option
 // and setting; options whose name starts with "exact" must give the default's counts bit for
 // bit (checked here: the run fails otherwise).
+// Rows with setting "stream" trace through an Embree scene with coherent_streams
+// (rtcOccluded1M, flagged coherent) instead of 16-ray packets.
 // Beside the CSV: FILE.png (seconds against mean_js, gnuplot) and FILE.gp (its script).
 // Also printed: min and median seconds per row, and the peak RSS of the process.
 #include <sys/resource.h>
@@ -86,6 +88,7 @@ double adjusted_rand_index(const std::vector<std::uint32_t>& a, const std::vecto
 struct config {
   std::string option, setting;
   visibility_channel channel;
+  bool stream = false;  // traced through the scene with coherent_streams (Embree's rtcOccluded1M)
 };
 
 std::vector<config> configs() {
@@ -101,6 +104,25 @@ std::vector<config> configs() {
   with("exact_coherent", "on", [](visibility_channel& c) { c.coherent = true; });
   with("exact_cull_hull", "on", [](visibility_channel& c) { c.cull_hull = true; });
   with("exact_coherent_cull_hull", "on", [](visibility_channel& c) { c.coherent = c.cull_hull = true; });
+  with("exact_coherent", "stream", [](visibility_channel& c) { c.coherent = true; });
+  out.back().stream = true;
+  with("exact_coherent_cull_hull", "stream", [](visibility_channel& c) { c.coherent = c.cull_hull = true; });
+  out.back().stream = true;
+  // Approximate: fewer samples, and adaptive sampling (all through coherent streams).
+  with("samples", "n1_stream", [](visibility_channel& c) { c.coherent = true; c.samples_per_side = 1; });
+  out.back().stream = true;
+  for (std::uint32_t n : {2u, 3u, 4u})
+    for (std::uint32_t probes : {1u, 2u, 4u}) {
+      if (probes >= n * n) continue;
+      char setting[32];
+      std::snprintf(setting, sizeof setting, "n%u_P%u_stream", n, probes);
+      with("adaptive", setting, [=](visibility_channel& c) {
+        c.coherent = true;
+        c.samples_per_side = n;
+        c.adaptive_probes = probes;
+      });
+      out.back().stream = true;
+    }
   return out;
 }
 
@@ -182,9 +204,10 @@ int pareto_visibility(int argc, char** argv) {
     auto topo = build_topology(*m);
     support::embree_device device("threads=1");
     support::embree_scene scene(device);
-    if (!scene.add_mesh(*m) || !scene.commit()) return 1;
+    support::embree_scene stream_scene(device, {.coherent_streams = true});
+    if (!scene.add_mesh(*m) || !scene.commit() || !stream_scene.add_mesh(*m) || !stream_scene.commit()) return 1;
     std::atomic<std::size_t> ray_count{0};
-    const counting_tracer tracer{&scene, &ray_count};
+    const counting_tracer tracer{&scene, &ray_count}, stream_tracer{&stream_scene, &ray_count};
     serial_executor exec;
     std::vector<std::vector<double>> seconds(cfg.size());
     std::vector<prepared_visibility_channel> prepared(cfg.size());
@@ -193,7 +216,7 @@ int pareto_visibility(int argc, char** argv) {
       for (std::size_t c = 0; c < cfg.size(); ++c) {
         ray_count = 0;
         const auto t0 = std::chrono::steady_clock::now();
-        auto p = cfg[c].channel.prepare(*m, *topo, tracer, exec);
+        auto p = cfg[c].channel.prepare(*m, *topo, cfg[c].stream ? stream_tracer : tracer, exec);
         seconds[c].push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         if (!p) {
           std::fprintf(stderr, "%s: %s\n", cfg[c].option.c_str(), p.error().message().c_str());

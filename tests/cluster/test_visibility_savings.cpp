@@ -36,13 +36,16 @@ TEST_CASE("point_support equals the maximum of a linear scan, and stops above th
 
 namespace {
 
-// Counts of plain tracing and of every exact option (serial, and 2 workers with odd grains).
+// Counts of plain tracing and of every exact option (serial, 2 workers with odd grains, and
+// through Embree's coherent ray streams).
 void require_exact_savings(const indexed_mesh& m, std::uint32_t viewpoints, std::uint32_t n, bool expect_culled,
                            std::size_t grain = 3) {
   support::embree_device device("threads=1");
-  support::embree_scene scene(device);
+  support::embree_scene scene(device), stream(device, {.coherent_streams = true});
   REQUIRE(scene.add_mesh(m).ok());
   REQUIRE(scene.commit().ok());
+  REQUIRE(stream.add_mesh(m).ok());
+  REQUIRE(stream.commit().ok());
   auto topo = build_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
@@ -58,6 +61,7 @@ void require_exact_savings(const indexed_mesh& m, std::uint32_t viewpoints, std:
       auto a = c.prepare(m, *topo, scene, serial);
       REQUIRE(a.ok());
       REQUIRE(a->visible == base->visible);
+      REQUIRE(c.prepare(m, *topo, stream, serial)->visible == base->visible);  // Embree's coherent streams
       c.grain = grain;
       support::thread_pool_executor pool{2};
       auto b = c.prepare(m, *topo, scene, pool);
@@ -118,4 +122,68 @@ TEST_CASE("visibility exact savings: identical counts on real meshes", "[cluster
   auto m = support::load_mesh(support::cgal_mesh("fandisk"));  // a CAD part: large flat hull faces
   REQUIRE(m.ok());
   require_exact_savings(*m, 16, 2, true, 61);
+}
+
+TEST_CASE("visibility adaptive sampling: the probe rule, its bound, and determinism", "[cluster][visibility]") {
+  // A box over a floor: shadows cross floor triangles between samples, so probes can be wrong.
+  indexed_mesh m = support::make_plane(8, 8, 2.0f);
+  support::append(m, support::make_box({-0.3f, -0.3f, 0.05f}, {0.3f, 0.3f, 0.5f}));
+  support::embree_device device("threads=1");
+  support::embree_scene scene(device);
+  REQUIRE(scene.add_mesh(m).ok());
+  REQUIRE(scene.commit().ok());
+  auto topo = build_topology(m);
+  REQUIRE(topo.ok());
+  serial_executor serial;
+  const std::uint32_t n = 3, ns = n * n;
+  const visibility_channel plain{.viewpoints = 48, .samples_per_side = n};
+  auto base = plain.prepare(m, *topo, scene, serial);
+  REQUIRE(base.ok());
+  SECTION("P >= n² traces every sample: the plain counts") {
+    for (std::uint32_t probes : {ns, ns + 5}) {
+      visibility_channel c = plain;
+      c.adaptive_probes = probes;
+      REQUIRE(c.prepare(m, *topo, scene, serial)->visible == base->visible);
+    }
+  }
+  SECTION("each entry is exact, or its probes agreed and it is off by at most n² − P") {
+    const visibility_setup su = plain.setup(m);
+    for (std::uint32_t probes : {1u, 2u, 4u}) {
+      visibility_channel c = plain;
+      c.adaptive_probes = probes;
+      c.coherent = probes == 2;
+      c.cull_hull = probes == 4;
+      auto a = c.prepare(m, *topo, scene, serial);
+      REQUIRE(a.ok());
+      std::size_t wrong = 0;
+      for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (std::size_t v = 0; v < plain.viewpoints; ++v) {
+          const int got = a->visible[t * plain.viewpoints + v], want = base->visible[t * plain.viewpoints + v];
+          if (got == want) continue;
+          ++wrong;
+          REQUIRE(std::abs(got - want) <= static_cast<int>(ns - probes));
+          // Agreed probes: the count is all front-facing samples or none, traced one by one here.
+          const triangle_corners tc = corners(m, t);
+          const glm::dvec3 nrm(triangle_normal(tc));
+          int front = 0, free_probes = 0;
+          for (std::size_t s = 0; s < ns; ++s) {
+            const glm::dvec2 w = su.samples[s];
+            const glm::dvec3 x = (1.0 - w.x - w.y) * tc.p0 + w.x * tc.p1 + w.y * tc.p2 + su.offset * nrm;
+            const glm::dvec3 d = su.viewpoints[v] - x;
+            if (glm::dot(nrm, d) <= 0.0) continue;
+            ++front;
+            bool probe = false;
+            for (std::size_t j = 0; j < probes; ++j) probe = probe || j * ns / probes == s;
+            if (probe) free_probes += scene.occluded(ray{glm::vec3(x), 0.0f, glm::vec3(d), 1.0f}) ? 0 : 1;
+          }
+          REQUIRE((got == front || got == 0));
+          REQUIRE(free_probes == (got == 0 ? 0 : static_cast<int>(probes)));
+        }
+      INFO("P = " << probes << ": " << wrong << " entries differ");
+      REQUIRE(wrong > 0);  // the scene does exercise the approximation
+      c.grain = 5;
+      support::thread_pool_executor pool{2};
+      REQUIRE(c.prepare(m, *topo, scene, pool)->visible == a->visible);
+    }
+  }
 }
