@@ -17,7 +17,8 @@
 // bit (checked here: the run fails otherwise).
 // Rows with setting "stream" trace through an Embree scene with coherent_streams
 // (rtcOccluded1M, flagged coherent) instead of 16-ray packets.
-// Beside the CSV: FILE.png (seconds against mean_js, gnuplot) and FILE.gp (its script).
+// Beside the CSV: FILE.png (seconds against mean_js, gnuplot) and FILE.gp (its script), with a
+// trailing .csv of FILE replaced.
 // Also printed: min and median seconds per row, and the peak RSS of the process.
 #include <sys/resource.h>
 
@@ -38,6 +39,7 @@
 #include "infolerp/core/executor.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 #include "pareto.hpp"
+#include "support/adjusted_rand_index.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
 
@@ -66,24 +68,6 @@ struct counting_tracer {
     scene->intersect(r, out);
   }
 };
-
-double adjusted_rand_index(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, double> joint;
-  std::map<std::uint32_t, double> ra, rb;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    joint[{a[i], b[i]}] += 1.0;
-    ra[a[i]] += 1.0;
-    rb[b[i]] += 1.0;
-  }
-  auto c2 = [](double n) { return n * (n - 1.0) / 2.0; };
-  double sij = 0.0, sa = 0.0, sb = 0.0;
-  for (auto& [k, n] : joint) sij += c2(n);
-  for (auto& [k, n] : ra) sa += c2(n);
-  for (auto& [k, n] : rb) sb += c2(n);
-  const double expected = sa * sb / c2(static_cast<double>(a.size()));
-  const double maximum = 0.5 * (sa + sb);
-  return maximum == expected ? 1.0 : (sij - expected) / (maximum - expected);
-}
 
 struct config {
   std::string option, setting;
@@ -149,14 +133,15 @@ double peak_rss_mb() {
 }
 
 void write_plot(const std::string& csv) {
-  const std::string gp = csv + ".gp", png = csv + ".png";
+  const std::string stem = csv.size() > 4 && csv.ends_with(".csv") ? csv.substr(0, csv.size() - 4) : csv;
+  const std::string gp = stem + ".gp", png = stem + ".png";
   FILE* f = std::fopen(gp.c_str(), "w");
   if (!f) return;
   std::fprintf(f,
-               "set datafile separator ','\nset terminal pngcairo size 900,560\nset output '%s'\n"
+               "set datafile separator ','\nset terminal pngcairo size 900,560 noenhanced\nset output '%s'\n"
                "set xlabel 'seconds (visibility channel, one core)'\nset ylabel 'mean JS of p(V|t) against n = 4 (bits)'\n"
-               "set logscale y\nset key outside right\nset grid\n"
-               "plot for [m in 'refined_elephant armadillo'] '%s' using ($1 eq m ? $4 : 1/0):($6 > 0 ? $6 : 1e-7) "
+               "set logscale xy\nset key outside right\nset grid\n"
+               "plot for [m in 'refined_elephant armadillo'] '%s' using (strcol(1) eq m ? $4 : 1/0):($6 > 0 ? $6 : 1e-7) "
                "with points pt 7 title m, '' using 4:($6 > 0 ? $6 : 1e-7):(sprintf('%%s %%s', stringcolumn(2), "
                "stringcolumn(3))) with labels font ',7' offset 0,0.6 notitle\n",
                png.c_str(), csv.c_str());
@@ -233,7 +218,7 @@ int pareto_visibility(int argc, char** argv) {
     const std::vector<std::uint32_t> ref_labels = visibility_clusters(*m, tracer, ref);
     prepared_visibility_channel moved = ref;
     moved.threshold *= 1.01;
-    const double ari_self = adjusted_rand_index(visibility_clusters(*m, tracer, moved), ref_labels);
+    const double ari_self = support::adjusted_rand_index(visibility_clusters(*m, tracer, moved), ref_labels);
     for (std::size_t c = 0; c < cfg.size(); ++c) {
       const bool exact = cfg[c].option.rfind("exact", 0) == 0;
       if (exact && prepared[c].visible != prepared[0].visible) {
@@ -248,7 +233,7 @@ int pareto_visibility(int argc, char** argv) {
         sum += js;
         worst = std::max(worst, js);
       }
-      const double ari = adjusted_rand_index(visibility_clusters(*m, tracer, prepared[c]), ref_labels);
+      const double ari = support::adjusted_rand_index(visibility_clusters(*m, tracer, prepared[c]), ref_labels);
       std::vector<double> s = seconds[c];
       std::sort(s.begin(), s.end());
       const double median = s[s.size() / 2];

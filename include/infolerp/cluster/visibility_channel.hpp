@@ -24,6 +24,8 @@
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
+// Options cut them: `coherent` and `cull_hull` exactly (the same counts), `adaptive_probes`
+// approximately (see visibility_channel).
 // OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
