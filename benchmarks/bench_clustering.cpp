@@ -10,6 +10,10 @@
 //                                   ARI >= 0.99 at >= 10x less time.
 //   BM_VisibilityChannel_Total / BM_VisibilityChannel_RaysOnly   the channel against the raw time
 //                                   of its own rays through the same tracer. Goal ≤ 1.3×.
+//   BM_VisibilityChannel_Exact/S/H  the channel with coherent = true, through 16-ray packets
+//                                   (S = 0) or Embree's coherent streams (S = 1), cull_hull = H;
+//                                   counts checked equal to Total's. Goal ≤ 0.6× Total.
+//                                   (Time against error of every option: infolerp_pareto visibility.)
 //   BM_Clustering_RefinedElephant_Ordered   the same on the mesh reordered for locality
 //                                   (triangles by Morton code, vertices by first use).
 //   BM_Clustering_RefinedElephant_Counted/E   the same through support::counting_channel, with
@@ -152,6 +156,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -161,6 +166,7 @@
 #include "infolerp/cluster/cluster_mesh.hpp"
 #include "infolerp/mesh/locality_order.hpp"
 #include "support/counting_channel.hpp"
+#include "support/adjusted_rand_index.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
@@ -252,25 +258,6 @@ double peak_rss_mb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
-
-// Adjusted Rand index of two labelings (Hubert & Arabie 1985).
-double adjusted_rand_index(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, double> joint;
-  std::map<std::uint32_t, double> ra, rb;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    joint[{a[i], b[i]}] += 1.0;
-    ra[a[i]] += 1.0;
-    rb[b[i]] += 1.0;
-  }
-  auto c2 = [](double n) { return n * (n - 1.0) / 2.0; };
-  double sij = 0.0, sa = 0.0, sb = 0.0;
-  for (auto& [k, n] : joint) sij += c2(n);
-  for (auto& [k, n] : ra) sa += c2(n);
-  for (auto& [k, n] : rb) sb += c2(n);
-  const double expected = sa * sb / c2(static_cast<double>(a.size()));
-  const double maximum = 0.5 * (sa + sb);
-  return maximum == expected ? 1.0 : (sij - expected) / (maximum - expected);
 }
 
 // FNV-1a of cluster_of, 24 bits (exact in a counter): speed work must leave it unchanged.
@@ -395,7 +382,7 @@ void direct_channel_bench(benchmark::State& state, const indexed_mesh& m, Make m
   state.counters["js_err_mean"] = err_sum / static_cast<double>(pairs);
   state.counters["js_err_max"] = err_max;
   state.counters["clusters"] = static_cast<double>(*std::max_element(labels.begin(), labels.end()) + 1);
-  state.counters["ari_vs_exact"] = adjusted_rand_index(labels, ref);
+  state.counters["ari_vs_exact"] = support::adjusted_rand_index(labels, ref);
 }
 
 const indexed_mesh& torus() {
@@ -463,6 +450,27 @@ void BM_VisibilityChannel_Total(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(e.mesh.triangles.size());
 }
 BENCHMARK(BM_VisibilityChannel_Total)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+void BM_VisibilityChannel_Exact(benchmark::State& state) {
+  auto& e = elephant();
+  if (!e.ok) return state.SkipWithError("refined_elephant not found");
+  static support::embree_scene stream = [&] {
+    support::embree_scene s(*e.device, {.coherent_streams = true});
+    if (!s.add_mesh(e.mesh) || !s.commit()) std::abort();
+    return s;
+  }();
+  visibility_channel c = elephant_visibility;
+  c.coherent = true;
+  c.cull_hull = state.range(1) != 0;
+  serial_executor exec;
+  prepared_visibility_channel p;
+  for (auto _ : state) {
+    p = std::move(*(state.range(0) != 0 ? c.prepare(e.mesh, e.topo, stream, exec) : c.prepare(e.mesh, e.topo, *e.tracer, exec)));
+    benchmark::DoNotOptimize(p);
+  }
+  if (p.visible != e.visibility.visible) state.SkipWithError("counts differ from the plain tracing");
+}
+BENCHMARK(BM_VisibilityChannel_Exact)->Args({0, 0})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->Iterations(2);
 
 // The same rays, same chunks, same tracer: only the trace_occluded calls are timed.
 void BM_VisibilityChannel_RaysOnly(benchmark::State& state) {

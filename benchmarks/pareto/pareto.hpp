@@ -23,3 +23,4 @@ inline double linear_psnr(const std::vector<glm::vec3>& a, const std::vector<glm
   return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
 }
 [[gnu::weak]] int pareto_lod(int argc, char** argv);
+[[gnu::weak]] int pareto_visibility(int argc, char** argv);

@@ -100,13 +100,15 @@ embree_scene::embree_scene(const embree_device& device, const embree_scene_optio
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(scene_, options.quality);
+  coherent_streams_ = options.coherent_streams;
 }
 
 embree_scene::embree_scene(embree_scene&& other) noexcept
     : device_(std::exchange(other.device_, nullptr)),
       scene_(std::exchange(other.scene_, nullptr)),
       geometry_count_(std::exchange(other.geometry_count_, 0)),
-      committed_(std::exchange(other.committed_, false)) {}
+      committed_(std::exchange(other.committed_, false)),
+      coherent_streams_(other.coherent_streams_) {}
 
 embree_scene& embree_scene::operator=(embree_scene&& other) noexcept {
   if (this != &other) {
@@ -116,6 +118,7 @@ embree_scene& embree_scene::operator=(embree_scene&& other) noexcept {
     scene_ = std::exchange(other.scene_, nullptr);
     geometry_count_ = std::exchange(other.geometry_count_, 0);
     committed_ = std::exchange(other.committed_, false);
+    coherent_streams_ = other.coherent_streams_;
   }
   return *this;
 }
@@ -199,6 +202,18 @@ void embree_scene::occluded(std::span<const ray> rays, std::span<std::uint8_t> o
   INFOLERP_ASSERT(committed_ && out.size() >= rays.size());
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  if (coherent_streams_) {
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    constexpr std::size_t stream = 256;
+    RTCRay er[stream];
+    for (std::size_t base = 0; base < rays.size(); base += stream) {
+      const std::size_t n = std::min(stream, rays.size() - base);
+      for (std::size_t i = 0; i < n; ++i) to_embree(rays[base + i], er[i]);
+      rtcOccluded1M(scene_, &context, er, static_cast<unsigned>(n), sizeof(RTCRay));
+      for (std::size_t i = 0; i < n; ++i) out[base + i] = er[i].tfar < 0.0f ? 1 : 0;
+    }
+    return;
+  }
   alignas(64) int valid[packet];
   alignas(64) RTCRay16 er;
   for (std::size_t base = 0; base < rays.size(); base += packet) {

@@ -50,6 +50,10 @@ class embree_device {
 struct embree_scene_options {
   bool robust = true;                                  // RTC_SCENE_FLAG_ROBUST: watertight, no accuracy-reducing shortcuts
   RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  // BVH build quality (HIGH adds spatial splits: slower build)
+  // Batched occlusion as one Embree ray stream (rtcOccluded1M) flagged coherent instead of
+  // 16-ray packets: Embree regroups the stream itself, which pays when the caller orders its
+  // rays coherently (e.g. visibility_channel::coherent). Same answers per ray.
+  bool coherent_streams = false;
 };
 
 // A scene of triangle meshes that models infolerp::tracer, batch_occlusion_tracer and
@@ -89,7 +93,8 @@ class embree_scene {
 
   // Tracing. Preconditions: committed(); out.size() >= rays.size() for the batch overloads.
   // Batches are traced as 16-ray packets (rtcOccluded16 / rtcIntersect16); the tail that is not
-  // a multiple of 16 goes in one packet with the unused lanes masked off.
+  // a multiple of 16 goes in one packet with the unused lanes masked off. With coherent_streams,
+  // batched occlusion goes through rtcOccluded1M instead (chunks of 256 rays).
   bool occluded(const ray& r) const;
   hit intersect(const ray& r) const;
   void occluded(std::span<const ray> rays, std::span<std::uint8_t> out) const;
@@ -100,6 +105,7 @@ class embree_scene {
   RTCScene scene_ = nullptr;
   std::uint32_t geometry_count_ = 0;
   bool committed_ = false;
+  bool coherent_streams_ = false;
 };
 
 static_assert(batch_occlusion_tracer<embree_scene> && batch_intersection_tracer<embree_scene>);

@@ -24,6 +24,8 @@
 //
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
+// Options cut them: `coherent` and `cull_hull` exactly (the same counts), `adaptive_probes`
+// approximately (see visibility_channel).
 // OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
@@ -38,6 +40,7 @@
 #include <span>
 #include <utility>
 #include <vector>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -51,6 +54,8 @@
 #include "infolerp/info/jensen_shannon.hpp"
 #include "infolerp/info/js_estimate.hpp"
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/mesh/locality_order.hpp"
+#include "infolerp/mesh/support_function.hpp"
 #include "infolerp/mesh/topology.hpp"
 
 namespace infolerp {
@@ -123,6 +128,95 @@ void make_visibility_rays(const M& m, const visibility_setup& setup, std::size_t
         slots.push_back(static_cast<std::uint32_t>((t - first) * nv + v));
       }
     }
+  }
+}
+
+// What cull_hull tests rays against: the support function of m's vertices, and the margin a
+// ray must clear beyond a supporting plane, 2⁻¹⁸ of the largest coordinate magnitude of the mesh
+// and the viewpoints (a tracer working in float errs by a few 2⁻²⁴ of it).
+// O(V log V), allocation O(V).
+struct visibility_hull {
+  point_support support;
+  double margin = 0.0;
+};
+template <class M>
+visibility_hull make_visibility_hull(const M& m, const visibility_setup& su) {
+  std::vector<glm::dvec3> points(mesh_vertex_count(m));
+  for (std::size_t v = 0; v < points.size(); ++v) points[v] = glm::dvec3(mesh_position(m, v));
+  double largest = 0.0;
+  auto widen = [&](const glm::dvec3& q) { largest = std::max({largest, std::abs(q.x), std::abs(q.y), std::abs(q.z)}); };
+  for (const glm::dvec3& q : points) widen(q);
+  for (const glm::dvec3& q : su.viewpoints) widen(q);
+  return {point_support(points), largest * 0x1p-18};
+}
+
+// The rays of the triangles `tris` (any order), with the exact savings of visibility_channel:
+// the same rays make_visibility_rays makes, bit for bit, with slot i·N + v for tris[i].
+//   by_viewpoint   rays grouped by viewpoint (then triangle, then sample) instead of by sample,
+//                  so that consecutive rays start close together and run nearly parallel.
+//   hull           when given, a ray whose segment lies beyond the plane n_t·y = h(n_t) + margin
+//                  (h the support function of every point the tracer's scene holds) cannot be
+//                  occluded: its slot goes to `free_slots` instead of `rays`. The test uses the
+//                  float origin and end the tracer would get.
+//   sample_on      when not empty, only the samples s with sample_on[s] != 0 get rays.
+//   pair_mode      when not empty, per slot: 0 no ray, 1 traced (as above), 2 counted free
+//                  without tracing (its slot goes to `free_slots` when front-facing).
+// O(|tris|·N·n²) + one support query per triangle, allocation of the
+// output vectors and |tris|·n² points in `scratch`.
+template <class M>
+void make_grouped_visibility_rays(const M& m, const visibility_setup& setup, std::span<const std::uint32_t> tris,
+                                  bool by_viewpoint, const visibility_hull* hull,
+                                  std::vector<glm::dvec3>& scratch, std::vector<ray>& rays,
+                                  std::vector<std::uint32_t>& slots, std::vector<std::uint32_t>& free_slots,
+                                  std::span<const std::uint8_t> sample_on = {}, std::span<const std::uint8_t> pair_mode = {}) {
+  static_assert(check_mesh<M>());
+  const std::size_t nv = setup.viewpoints.size(), ns = setup.samples.size(), k = tris.size();
+  // Per triangle: its normal (row i·(ns + 2)), then the plane bound (x = h + margin, +inf when no
+  // ray of it can be proven free), then its sample origins.
+  scratch.assign(k * (ns + 2), glm::dvec3(0.0));
+  for (std::size_t i = 0; i < k; ++i) {
+    const triangle_corners c = corners(m, tris[i]);
+    const glm::dvec3 n = glm::dvec3(triangle_normal(c));
+    glm::dvec3* row = scratch.data() + i * (ns + 2);
+    row[0] = n;
+    double highest = -std::numeric_limits<double>::infinity();  // of n·(float origin)
+    for (std::size_t s = 0; s < ns; ++s) {
+      const glm::dvec2 w = setup.samples[s];
+      row[2 + s] = (1.0 - w.x - w.y) * c.p0 + w.x * c.p1 + w.y * c.p2 + setup.offset * n;
+      highest = std::max(highest, glm::dot(n, glm::dvec3(glm::vec3(row[2 + s]))));
+    }
+    double bound = std::numeric_limits<double>::infinity();  // above every origin: nothing is free
+    if (hull != nullptr && n != glm::dvec3(0.0))
+      bound = hull->support.support_up_to(n, glm::dot(n, c.p0), highest - hull->margin) + hull->margin;
+    row[1].x = bound;
+  }
+  auto emit = [&](std::size_t i, std::size_t s, std::size_t v) {
+    const auto slot = static_cast<std::uint32_t>(i * nv + v);
+    const std::uint8_t mode = pair_mode.empty() ? 1 : pair_mode[slot];
+    if (mode == 0 || (!sample_on.empty() && sample_on[s] == 0)) return;
+    const glm::dvec3* row = scratch.data() + i * (ns + 2);
+    const glm::dvec3 n = row[0], x = row[2 + s];
+    const glm::dvec3 d = setup.viewpoints[v] - x;
+    if (glm::dot(n, d) <= 0.0) return;  // back-facing
+    const ray r{glm::vec3(x), 0.0f, glm::vec3(d), 1.0f};
+    const glm::dvec3 o(r.origin), e = o + glm::dvec3(r.direction);
+    if (mode == 2 || std::min(glm::dot(n, o), glm::dot(n, e)) > row[1].x) {
+      free_slots.push_back(slot);
+    } else {
+      rays.push_back(r);
+      slots.push_back(slot);
+    }
+  };
+  if (by_viewpoint) {
+    for (std::size_t v = 0; v < nv; ++v)
+      for (std::size_t i = 0; i < k; ++i)
+        if (scratch[i * (ns + 2)] != glm::dvec3(0.0))
+          for (std::size_t s = 0; s < ns; ++s) emit(i, s, v);
+  } else {
+    for (std::size_t i = 0; i < k; ++i)
+      if (scratch[i * (ns + 2)] != glm::dvec3(0.0))
+        for (std::size_t s = 0; s < ns; ++s)
+          for (std::size_t v = 0; v < nv; ++v) emit(i, s, v);
   }
 }
 
@@ -433,6 +527,29 @@ struct visibility_channel {
   std::size_t grain = 64;              // triangles per parallel task
   // Called on the calling thread between waves of tasks with (triangles done, total).
   std::function<void(std::size_t, std::size_t)> progress = {};
+  // Exact savings: the counts (and so every result) stay bit-identical to the plain tracing.
+  //   coherent    triangles are traced in Morton order of their centroids (chunks of `grain`),
+  //               and each chunk's rays are grouped by viewpoint, so the tracer's batch call gets
+  //               runs of nearly parallel rays from close origins (packet and stream tracers gain).
+  //               Exact for any tracer whose answer for a ray does not depend on its batch mates.
+  //   cull_hull   rays beyond a supporting plane of the mesh's convex hull are counted free
+  //               without tracing: every ray from a triangle lying on the hull toward a viewpoint
+  //               it faces (the sample offset lifts the origin off that plane). Exact when the
+  //               tracer's scene holds nothing outside the convex hull of m's vertices and the
+  //               tracer finds no hit on a segment farther than 2⁻¹⁸ of the largest coordinate
+  //               magnitude from every triangle (Embree's robust mode; rays closer are traced).
+  //               With other geometry around the mesh, leave it off.
+  bool coherent = false;
+  bool cull_hull = false;
+  // Approximate saving (adaptive sampling): with adaptive_probes = P in 1..n²−1, each
+  // (triangle, viewpoint) first traces P probe samples spread over its n² (indices ⌊j·n²/P⌋);
+  // when every probe faces the viewpoint and all are free (or all occluded), the other samples
+  // are counted the same without tracing (free ones only where they face it); otherwise they
+  // are traced. Rule: agreement of the probes alone (neighbouring triangles are not consulted).
+  // Error: an entry is wrong only where a shadow or silhouette edge crosses the triangle
+  // between probes, by at most (n² − P)/n² of OR; benchmarks/NOTES.md has the measured JS and
+  // ARI. 0 (or P >= n²) traces every sample. Implies the grouped path (as with coherent).
+  std::uint32_t adaptive_probes = 0;
 
   // The viewpoints and samples this configuration uses for mesh m.
   template <class M>
@@ -468,6 +585,22 @@ struct visibility_channel {
     p.neighbour_offsets = topo.neighbour_offsets;
     p.neighbours = topo.neighbours;
     const std::size_t g = std::max<std::size_t>(grain, 1);
+    const std::size_t ns = su.samples.size();
+    const std::size_t probes = adaptive_probes < ns ? adaptive_probes : 0;
+    const bool grouped = coherent || cull_hull || probes > 0;
+    std::vector<std::uint8_t> probe_on(ns, 0), rest_on(ns, 1);
+    for (std::size_t j = 0; j < probes; ++j) {
+      probe_on[j * ns / probes] = 1;
+      rest_on[j * ns / probes] = 0;
+    }
+    std::vector<std::uint32_t> order;  // triangles in tracing order (grouped only)
+    if (coherent) {
+      order = morton_triangle_order(m);
+    } else if (grouped) {
+      order.resize(nt);
+      for (std::size_t t = 0; t < nt; ++t) order[t] = static_cast<std::uint32_t>(t);
+    }
+    const visibility_hull hull = cull_hull ? make_visibility_hull(m, su) : visibility_hull{};
     const std::size_t chunks = chunk_count(nt, g), per_wave = 64;
     for (std::size_t w0 = 0; w0 < chunks; w0 += per_wave) {
       const std::size_t w1 = std::min(chunks, w0 + per_wave);
@@ -475,15 +608,53 @@ struct visibility_channel {
         std::vector<ray> rays;
         std::vector<std::uint32_t> slots;
         std::vector<std::uint8_t> hit;
+        std::vector<std::uint32_t> free_slots;
+        std::vector<glm::dvec3> scratch;
+        std::vector<std::uint8_t> faced, free_probes, mode;  // adaptive sampling, per slot
         for (std::size_t c = w0 + cb; c < w0 + ce; ++c) {
           const std::size_t first = c * g, last = std::min(nt, first + g);
           rays.clear();
           slots.clear();
-          make_visibility_rays(m, su, first, last, rays, slots);
+          if (!grouped) {
+            make_visibility_rays(m, su, first, last, rays, slots);
+            hit.resize(rays.size());
+            trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
+            std::uint8_t* out = p.visible.data() + first * nv;
+            for (std::size_t r = 0; r < rays.size(); ++r) if (!hit[r]) ++out[slots[r]];
+            continue;
+          }
+          free_slots.clear();
+          const std::span<const std::uint32_t> tris(order.data() + first, last - first);
+          auto count = [&](std::uint32_t slot) { ++p.visible[std::size_t{tris[slot / nv]} * nv + slot % nv]; };
+          const visibility_hull* h = cull_hull ? &hull : nullptr;
+          if (probes > 0) {  // the probes, then the rest where they disagree
+            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, probe_on);
+            hit.resize(rays.size());
+            trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
+            faced.assign(tris.size() * nv, 0);
+            free_probes.assign(tris.size() * nv, 0);
+            for (std::size_t r = 0; r < rays.size(); ++r) {
+              ++faced[slots[r]];
+              if (!hit[r]) ++free_probes[slots[r]];
+            }
+            for (std::uint32_t slot : free_slots) ++faced[slot], ++free_probes[slot];
+            mode.resize(faced.size());
+            for (std::size_t q = 0; q < faced.size(); ++q) {
+              const auto slot = static_cast<std::uint32_t>(q);
+              for (std::uint8_t f = 0; f < free_probes[q]; ++f) count(slot);
+              mode[q] = faced[q] < probes ? 1 : free_probes[q] == probes ? 2 : free_probes[q] == 0 ? 0 : 1;
+            }
+            rays.clear();
+            slots.clear();
+            free_slots.clear();
+            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, rest_on, mode);
+          } else {
+            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots);
+          }
           hit.resize(rays.size());
           trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
-          std::uint8_t* out = p.visible.data() + first * nv;
-          for (std::size_t r = 0; r < rays.size(); ++r) if (!hit[r]) ++out[slots[r]];
+          for (std::size_t r = 0; r < rays.size(); ++r) if (!hit[r]) count(slots[r]);
+          for (std::uint32_t slot : free_slots) count(slot);
         }
       });
       if (progress) progress(std::min(nt, w1 * g), nt);
