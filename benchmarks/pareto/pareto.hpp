@@ -10,6 +10,8 @@
 [[gnu::weak]] int pareto_refine(int argc, char** argv);
 [[gnu::weak]] int pareto_upsample(int argc, char** argv);
 [[gnu::weak]] int pareto_walk(int argc, char** argv);
+[[gnu::weak]] int pareto_lod(int argc, char** argv);
+[[gnu::weak]] int pareto_visibility(int argc, char** argv);
 
 // PSNR in dB of image a against reference b on linear colours clamped to [0, 1] (99 when equal),
 // as the refinement harnesses measure it.
@@ -22,5 +24,3 @@ inline double linear_psnr(const std::vector<glm::vec3>& a, const std::vector<glm
   const double mse = se / double(a.size());
   return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
 }
-[[gnu::weak]] int pareto_lod(int argc, char** argv);
-[[gnu::weak]] int pareto_visibility(int argc, char** argv);
