@@ -1,5 +1,5 @@
 // Topology build throughput on a real ~100k-triangle mesh (CGAL's refined_elephant).
-// Goal (issue 2): at least 5 million triangles per second on one core.
+// Goal: at least 5 million triangles per second on one core.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>

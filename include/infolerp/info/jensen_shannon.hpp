@@ -14,12 +14,8 @@
 // __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one,
 // INFOLERP_NO_AVX512 to stop at AVX2. Bins are processed in blocks in two stages (ratios and
 // divisions, then polynomials) so that out-of-order cores overlap them; a bin takes two
-// divisions (1/m, and one for both atanh arguments). Measured (BM_JensenShannon*,
-// benchmarks/bench_info.cpp, CPU time, one core of the shared 2-core dev VM at load 1.7,
-// portable flags, AVX-512 dispatched): about 420 million bins/s for double rows, 390 million
-// for float rows (the previous AVX2 kernel with three divisions per bin: 350 / 340 million in
-// the same runs; std::log2 per bin: about 88 million); a 64-bin float row pair (the
-// visibility channel) about 158 ns (was 189), a 257-bin double pair about 660 ns (was 748).
+// divisions (1/m, and one for both atanh arguments). Throughput beside std::log2 per bin:
+// benchmarks/NOTES.md (BM_JensenShannon).
 // Other compilers get the same arithmetic one bin at a time. Four accumulators, combined as
 // (a0+a1)+(a2+a3), bin i going to a_(i mod 4) (8-lane vectors add their two halves in turn):
 // the result is bit-identical for every vector width, so the dispatch never changes a result

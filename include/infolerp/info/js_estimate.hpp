@@ -28,14 +28,9 @@
 // Speed: the portable build runs 8-float GNU vectors on SSE2; on x86-64 an AVX2+FMA copy and a
 // 16-float AVX-512F copy are chosen at run time (the bound holds for each, and each is tested;
 // their bits may differ, which is why results never depend on an estimate's value, only on
-// decisions it proves). Measured (BM_JensenShannon_Column_*, benchmarks/bench_info.cpp, one
-// row against 4096): on the AMD EPYC VM without AVX-512 (AVX2+FMA), a 64-bin float row pair
-// 104 ns against 639 ns exact (6.2x), a 257-bin double pair 593 ns against 2.2 µs (3.7x: the
-// conversion to float; the direct channels keep float copies of their rows for this); on the
-// AMD EPYC VM with AVX-512 of 2026-12-02, 64 float bins 24.4 -> 19.8-20.9 ns with the AVX-512 copy
-// (exact 92 ns), 257 double bins 650 -> 353 ns (exact 339 ns, itself on AVX-512: for double
-// rows the estimate is no faster there). Worst error seen: 3.8e-7 at 64 bins (bound 2.6e-5),
-// 8.0e-7 at 257 (bound 6.4e-5).
+// decisions it proves). The estimate pays off for float rows (the direct channels keep float
+// copies of their rows for it); for double rows the conversion eats most of the gain
+// (benchmarks/NOTES.md, BM_JensenShannon_Column).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -43,22 +43,7 @@
 // most); they differ only by FMA contraction (1e-16 relative per operation). Other compilers get
 // a plain 4-double struct. exp(−x) on [0, 2] (the only range the ball cutoff produces) is a
 // polynomial fit, relative error ~1e-16.
-// Measured (refined_elephant subdivided once, 177,852 vertices, 584M unordered pairs within
-// 2σ_max, 750M candidates; 2-core Intel Xeon VM with AVX-512, shared with other jobs; CPU time of
-// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), 2.48 s AVX2,
-// 3.94 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the
-// same machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%
-// (simulated from per-tile times), and ~0.12 s of the call is serial (curvature 19 ms, topology
-// 31 ms, point grid 20 ms, normalisation 17 ms, ...): BM_Saliency_Exact/2 took 0.925–0.950 s
-// wall on 2 idle cores (goal 1.0 s). Where the kernel's time goes (AVX-512): exps ~20%, the
-// candidates' sums in memory ~23%. On an AVX2-only machine the 1-thread time is ~1.4× (2.48 s):
-// the 1.0 s goal would be missed there. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2,
-// 0.32 s portable (was 0.35 s AVX2).
-// Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
-// the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
-// by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
-// computed one block ahead; coordinates interleaved by block; w_8ε = w_12ε²·exp(−x_12ε/4) instead
-// of an exp; columns 2σ_max/2, /4 or /5 wide (all within noise or slower).
+// Measured times per kernel and what was tried instead: benchmarks/NOTES.md (BM_Saliency_Exact).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
@@ -67,37 +52,9 @@
 // exp(−d²/2σ²)·(count, sum C) over representatives near its ball; a representative straddling
 // the 2σ edge counts with a linear ramp over ±1.5 × its spread (a single vertex keeps the hard
 // cutoff), which removes most of the in/out error of whole cells.
-// Measured relative L2 error of the final saliency against exact: on a 10k-vertex bumpy sphere
-// (tests) 5.0% at 2 cells per σ, 2.0% at 3, 0.11% at 4 (the default); on refined_elephant
-// subdivided once 7.9% at 2, 6.2% at 3, 3.7% at 4, where Lee's local-maxima normalisation
-// amplifies small level errors. On that mesh this mode is no faster than exact (5.5, 8.9 and
-// 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes. Re-measured there
-// (BM_Saliency_Approx, 2 threads, load average 2.3–2.7): 9.6% at 1 cell per σ (1.96 s wall),
-// 7.9% at 2 (3.6 s), 6.2% at 3 (4.3 s), 3.7% at 4 (5.8 s), 2.8% at 5 (13.6 s), 1.45% at 6
-// (19.8 s); exact took 6.2 s wall in the same run. The issue's goal (0.1 s at 1%) is not met.
-// Lattice schemes tried instead (branch salapprox, issue 4) and not kept, because they fail the
-// 1% test on the bumpy sphere (lattice spacing h = σ / cells per σ, refined_elephant subdivided
-// once, error = relative L2 of the final saliency against exact, CPU time of the whole call):
-//   - splat–gather–slice: trilinear splat of (1, C), node-to-node ball-truncated Gaussian
-//     (σ_n² = σ² − h²/3), trilinear slice: 11.4% at 1 cell per σ (0.42 s CPU), 9.0% at 2
-//     (1.1 s), 8.8% at 4 (7.4 s), 7.2% at 6 (32 s); bumpy sphere 4.2% at 4.
-//   - exact ball averages at the lattice nodes, trilinear slice: 10.8% at 1 (0.63 s CPU), 9.0%
-//     at 2 (1.5 s), 8.3% at 3 (2.6 s), 7.5% at 4 (4.0 s), 6.4% at 5 (5.2 s), 5.1% at 6 (6.1 s,
-//     as slow as exact); bumpy sphere 8.8% at 4.
-// Both converge slowly because S_i = |G(σ) − G(2σ)| is a small difference of two averages
-// (worst level errors 14–33% on the bumpy sphere), and the hard 2σ cutoff (a step of e⁻² in the
-// kernel) is smeared by any lattice: its error is first order in h/σ.
-// Why the 1% goal is out of reach for any smooth approximation (measured on the same mesh, with
-// the exact ball sums split per vertex into a near part, |x − v| < r0, and a far part): replacing
-// only the far part by its average over each vertex's 1-ring (an optimistic stand-in for any
-// approximation that is smooth at the scale of one vertex spacing, ~0.56ε here) changes the
-// final saliency by 4.5% for r0 = 4ε, 2.3% for r0 = 12ε and 0.34% for r0 = 18ε. The hard 2σ
-// edge makes G(σ) jump as single vertices cross it, and that vertex-scale structure is part of
-// S (averaging the final saliency itself over 1-rings changes it by 1.4%). Staying within 1%
-// therefore needs exact pair sums out to ~18ε, 56% of the pairs within 2σ_max = 24ε: at most
-// ~1.8× faster than exact, never 10×. For scale: exact itself moves by 0.24% when ε changes by
-// 1e-4 relative, 0.41% at 1e-3, 1.0% at 1e-2, and by 0.28% under a position jitter of 1e-5 of
-// the diagonal.
+// Its error against exact is a few per cent on large meshes, where it is no faster than exact;
+// the hard 2σ edge keeps any smooth approximation from 1% (benchmarks/NOTES.md,
+// BM_Saliency_Approx).
 #include <algorithm>
 #include <array>
 #include <cmath>
