@@ -66,6 +66,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/cpu.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
@@ -98,11 +99,6 @@ struct mesh_saliency {
 
 namespace detail {
 
-#if defined(__GNUC__) || defined(__clang__)
-#define INFOLERP_SALIENCY_INLINE __attribute__((always_inline)) inline  // compiled into each ISA version
-#else
-#define INFOLERP_SALIENCY_INLINE inline
-#endif
 
 // x ← exp(−x) for x in [0, 2] (the only range the 2σ ball cutoff produces), for double or a
 // vector of doubles: q(x)⁴ with q the degree-10 Chebyshev fit of exp(−x/4) on [0, 2]. Relative
@@ -110,7 +106,7 @@ namespace detail {
 // infinite values that callers mask out. In place: vector arguments by value would trip GCC's
 // -Wpsabi note in the user's translation unit.
 template <class T>
-INFOLERP_SALIENCY_INLINE void exp_neg_inplace(T& x) {
+INFOLERP_FORCE_INLINE void exp_neg_inplace(T& x) {
   // Estrin's scheme: 4 dependent multiply-adds instead of Horner's 10 (the kernel is latency-bound).
   const T x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
   const T p01 = x * -0.24999999999999944 + 1.0, p23 = x * -0.0026041666665787633 + 0.03124999999998875;
@@ -323,19 +319,19 @@ using v4d = double __attribute__((vector_size(32)));
 // out = v where m, else +0 (bitwise, so an Inf outside the ball is harmless). Arguments by
 // reference: vector arguments by value would trip GCC's -Wpsabi note in the user's code.
 template <class V, class M>
-INFOLERP_SALIENCY_INLINE void keep(V& out, const M& m, const V& v) {
+INFOLERP_FORCE_INLINE void keep(V& out, const M& m, const V& v) {
   out = reinterpret_cast<V>(m & reinterpret_cast<M>(v));
 }
 // a = min(a, b) per lane (for finite values or +Inf).
 template <class V>
-INFOLERP_SALIENCY_INLINE void lane_min(V& a, const V& b) {
+INFOLERP_FORCE_INLINE void lane_min(V& a, const V& b) {
   const auto m = b < a;
   using M = decltype(m);
   a = reinterpret_cast<V>((m & reinterpret_cast<M>(b)) | (~m & reinterpret_cast<M>(a)));
 }
 // The smallest lane of v, by halving (log2(width) shuffles and minima, not width − 1 scalar ones).
 template <class V>
-INFOLERP_SALIENCY_INLINE double lanes_min(const V& lanes) {
+INFOLERP_FORCE_INLINE double lanes_min(const V& lanes) {
   constexpr std::size_t width = sizeof(V) / sizeof(double);
   V v = lanes;
   if constexpr (width == 8) {
@@ -364,12 +360,12 @@ inline double lanes_min(const lanes_fallback& v) {
 }
 
 template <class V>
-INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
+INFOLERP_FORCE_INLINE void load_lanes(V& v, const double* p) {
   std::memcpy(&v, p, sizeof v);
 }
 
 template <class V>
-INFOLERP_SALIENCY_INLINE void store_lanes(double* p, const V& v) {
+INFOLERP_FORCE_INLINE void store_lanes(double* p, const V& v) {
   std::memcpy(p, &v, sizeof v);
 }
 
@@ -406,7 +402,7 @@ struct column_tile {
 // LC >= the number of σ: the σ loop is unrolled (8 at a time) so that, with LC = 8, i's sums
 // stay in registers (AVX-512: 16 of its 32).
 template <class V, std::size_t LC>
-INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
+INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                           column_tile tile, double* sums) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
   const std::size_t L = t.r2.size();
@@ -508,7 +504,7 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
 
 // One tile with vectors V, 8 or 32 σ slots.
 template <class V>
-INFOLERP_SALIENCY_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
+INFOLERP_FORCE_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                               column_tile tile, double* sums) {
   if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, sums);
   gather_tile<V, 32>(g, t, span, tile, sums);
@@ -525,8 +521,7 @@ inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std
 
 // Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel, INFOLERP_NO_AVX512 to
 // use AVX2 at most.
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
-#define INFOLERP_SALIENCY_X86 1
+#ifdef INFOLERP_X86_DISPATCH
 using v8d = double __attribute__((vector_size(64)));
 __attribute__((target("avx2,fma"))) inline void gather_tile_avx2(const column_grid& g, const sigma_table& t,
                                                                  std::uint32_t span, column_tile tile, double* sums) {
@@ -536,13 +531,6 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
                                                                            std::uint32_t span, column_tile tile,
                                                                            double* sums) {
   gather_tile_any<v8d>(g, t, span, tile, sums);
-}
-// 2: AVX-512F, 1: AVX2 and FMA, 0: neither.
-inline int x86_vector_level() {
-#ifndef INFOLERP_NO_AVX512
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma")) return 2;
-#endif
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? 1 : 0;
 }
 #endif
 #if defined(__GNUC__) || defined(__clang__)
@@ -566,7 +554,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   const std::size_t stride = g.stride;
   std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
   double* sums = storage.data() + aligned_offset(storage);
-#ifdef INFOLERP_SALIENCY_X86
+#ifdef INFOLERP_X86_DISPATCH
   const int level = x86_vector_level();
 #endif
   // Tiles of span × span columns: a tile writes its own columns and those up to span later in x,
@@ -585,7 +573,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
     std::stable_sort(tiles.begin(), tiles.end(), [](const column_tile& a, const column_tile& b) { return a.points > b.points; });
     exec.parallel_for(tiles.size(), std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
-#ifdef INFOLERP_SALIENCY_X86
+#ifdef INFOLERP_X86_DISPATCH
         if (level == 2) {
           gather_tile_avx512(g, t, span, tiles[k], sums);
           continue;
