@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # What including infolerp costs a translation unit: g++ -fsyntax-only on a TU that includes a
 # header, against a TU that includes only the standard and GLM headers it pulls in (every
-# `#include <...>` of the infolerp headers it reaches). Min of REPS runs each, interleaved, so
-# the ratio holds under load better than either time.
+# `#include <...>` of the infolerp headers it reaches). CPU time (user + system), min of REPS runs
+# each, interleaved, so the ratio holds under load better than either time.
 #
-#   tests/include_cost.sh [--check] [--all] [CXX]
-#     (no flag)  the umbrella header infolerp/infolerp.hpp
+#   tests/include_cost.sh [--check] [--all] [CXX] [HEADER...]
+#     (no flag)  the umbrella header infolerp/infolerp.hpp, and each HEADER (e.g. infolerp/mesh/topology.hpp)
 #     --all      also every public header (a few minutes)
 #     --check    exit 1 when the umbrella costs more than 1.5x its std+GLM includes
 # Goals: umbrella <= 1.5x its std+GLM includes; no public header adds more than 0.5 s over its
@@ -13,11 +13,12 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 inc="$here/include"
-check=0 all=0 cxx=g++
+check=0 all=0 cxx=g++ extra=()
 for a in "$@"; do
   case "$a" in
     --check) check=1 ;;
     --all) all=1 ;;
+    *.hpp) extra+=("$a") ;;
     *) cxx=$a ;;
   esac
 done
@@ -33,12 +34,10 @@ base_includes() {
     xargs grep -h -E '^[[:space:]]*#[[:space:]]*include[[:space:]]*<' | sed -E 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*/#include /' | sort -u
 }
 
-seconds() {  # compile TU $1, print wall seconds
-  local t0 t1
-  t0=$(date +%s.%N)
-  "$cxx" "${flags[@]}" "$1"
-  t1=$(date +%s.%N)
-  echo "$t1 - $t0" | bc -l
+seconds() {  # compile TU $1, print the compiler's CPU seconds (user + system: moves less with load than wall time)
+  local TIMEFORMAT='%3U %3S' t
+  t=$( { time "$cxx" "${flags[@]}" "$1" >/dev/null; } 2>&1 )
+  echo "${t% *} + ${t#* }" | bc -l
 }
 
 min() { printf '%s\n' "$@" | sort -g | head -1; }
@@ -64,11 +63,12 @@ measure() {
 
 echo "$("$cxx" --version | head -1); $(lscpu | sed -n 's/^Model name: *//p' | head -1); load $(cut -d' ' -f1-3 /proc/loadavg); min of $reps"
 echo
-echo "| header | -fsyntax-only (s) | its std+GLM includes (s) | ratio | added (s) |"
+echo "| header | -fsyntax-only, CPU (s) | its std+GLM includes (s) | ratio | added (s) |"
 echo "|---|---|---|---|---|"
 measure infolerp/infolerp.hpp
 umbrella_ratio=$last_ratio
 status=0
+for h in "${extra[@]}"; do measure "$h"; done
 if ((all)); then
   worst=0 worst_h=
   while read -r h; do
