@@ -351,7 +351,7 @@ void BM_VisibilityChannel_RaysOnly(benchmark::State& state) {
     for (std::size_t first = 0; first < nt; first += g) {
       rays.clear();
       slots.clear();
-      make_visibility_rays(e.mesh, su, first, std::min(nt, first + g), rays, slots);
+      infolerp::detail::make_visibility_rays(e.mesh, su, first, std::min(nt, first + g), rays, slots);
       out.resize(rays.size());
       const auto t0 = std::chrono::steady_clock::now();
       trace_occluded(*e.tracer, std::span<const ray>(rays), std::span<std::uint8_t>(out));

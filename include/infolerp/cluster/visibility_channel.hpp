@@ -104,7 +104,9 @@ struct visibility_setup {
 
 // Appends the occlusion rays of triangles [first, last) to `rays`, and for each ray its slot
 // (t − first)·N + v to `slots`. Back-facing sample/viewpoint pairs get no ray (OR term 0).
-// Exposed so that benchmarks can time the same rays alone. O((last − first)·N·n²).
+// In detail: not part of the API; benchmarks call it to time the same rays alone.
+// O((last − first)·N·n²).
+namespace detail {
 template <class M>
 void make_visibility_rays(const M& m, const visibility_setup& setup, std::size_t first, std::size_t last,
                           std::vector<ray>& rays, std::vector<std::uint32_t>& slots) {
@@ -125,6 +127,7 @@ void make_visibility_rays(const M& m, const visibility_setup& setup, std::size_t
     }
   }
 }
+}  // namespace detail
 
 // A visibility channel initialised on a set of triangles. Classes are elements.
 class visibility_state {
@@ -479,7 +482,7 @@ struct visibility_channel {
           const std::size_t first = c * g, last = std::min(nt, first + g);
           rays.clear();
           slots.clear();
-          make_visibility_rays(m, su, first, last, rays, slots);
+          detail::make_visibility_rays(m, su, first, last, rays, slots);
           hit.resize(rays.size());
           trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
           std::uint8_t* out = p.visible.data() + first * nv;
