@@ -50,7 +50,9 @@ def get(name, key="real_time"):
     return v[0], statistics.median(v), v[-1]
 
 def fmt(x, digits=3):
-    return "n/a" if x is None else f"{x:.{digits}g}"
+    if x is None:
+        return "n/a"
+    return f"{x:.0f}" if abs(x) >= 10 ** (digits - 1) else f"{x:.{digits}g}"
 
 def mm(t, unit, digits=3, largest=False):
     if t is None:
@@ -69,12 +71,14 @@ def row(what, value, reference, ratio_text, goal):
     rows.append(f"| {what} | {value} | {reference} | {ratio_text} | {goal} |")
 
 M = 1e-6
-js = get("BM_JensenShannon/1048576", "bins_per_second")
-jsn = get("BM_JensenShannon_Naive/1048576", "bins_per_second")
-row("Jensen–Shannon, double, 2^20 bins, one core (bins/s)",
-    mm(js and tuple(x * M for x in js), "M", largest=True),
-    "naive `std::log2` per bin: " + mm(jsn and tuple(x * M for x in jsn), "M", largest=True),
-    ratio(js, jsn, largest=True), "≥ 200 M/s")
+def rate_row(what, name, ref_label, ref_name, counter, goal, ref_over_value=False, suffix=""):
+    a, b = get(name, counter), get(ref_name, counter)
+    mega = lambda t: t and tuple(x * M for x in t)
+    r = ratio(b, a, largest=True) if ref_over_value else ratio(a, b, largest=True)
+    row(what, mm(mega(a), "M", largest=True), ref_label + ": " + mm(mega(b), "M", largest=True), r + suffix, goal)
+
+rate_row("Jensen–Shannon, double, 2^20 bins, one core (bins/s)", "BM_JensenShannon/1048576",
+         "naive `std::log2` per bin", "BM_JensenShannon_Naive/1048576", "bins_per_second", "≥ 200 M/s")
 G = 1e9  # counters with kInvert are in seconds
 def ns(t):
     return t and tuple(x * G for x in t)
@@ -82,26 +86,19 @@ est = ns(get("BM_JensenShannon_Column_Float/64/1", "ns_per_pair"))
 exa = ns(get("BM_JensenShannon_Column_Float/64/0", "ns_per_pair"))
 row("JS estimate, 64 float bins, one row against 4096 (ns per pair)", mm(est, "ns"),
     "exact kernel: " + mm(exa, "ns"), ratio(exa, est) + " faster", "screens most comparisons")
-topo = get("BM_Topology_RefinedElephant", "triangles_per_second")
-cp = get("BM_Topology_RefinedElephant_Memcpy", "triangles_per_second")
-row("topology build, refined_elephant, one core (triangles/s)",
-    mm(topo and tuple(x * M for x in topo), "M", largest=True),
-    "memcpy of the index buffer: " + mm(cp and tuple(x * M for x in cp), "M", largest=True),
-    ratio(cp, topo, largest=True) + " slower than the copy", "≥ 5 M/s")
-pk = get("BM_Embree_Occluded_Packet16", "rays_per_second")
-sg = get("BM_Embree_Occluded_Single", "rays_per_second")
-row("Embree occlusion rays, bunny00, incoherent, 16-ray packets (rays/s)",
-    mm(pk and tuple(x * M for x in pk), "M", largest=True),
-    "single rays: " + mm(sg and tuple(x * M for x in sg), "M", largest=True),
-    ratio(pk, sg, largest=True), "—")
+rate_row("topology build, refined_elephant, one core (triangles/s)", "BM_Topology_RefinedElephant",
+         "memcpy of the index buffer", "BM_Topology_RefinedElephant_Memcpy", "triangles_per_second", "≥ 5 M/s",
+         ref_over_value=True, suffix=" slower than the copy")
+rate_row("Embree occlusion rays, bunny00, incoherent, 16-ray packets (rays/s)", "BM_Embree_Occluded_Packet16",
+         "single rays", "BM_Embree_Occluded_Single", "rays_per_second", "—")
 vt = get("BM_VisibilityChannel_Total/iterations:2")
 vr = get("BM_VisibilityChannel_RaysOnly/iterations:2/manual_time")
-row("visibility channel, refined_elephant, 64 viewpoints, one core (ms)", mm(vt, "ms"),
+row("visibility channel, refined_elephant, 64 viewpoints, one core, wall (ms)", mm(vt, "ms"),
     "its own rays alone, same tracer: " + mm(vr, "ms"), ratio(vt, vr), "≤ 1.3×")
-cl = get("BM_Clustering_RefinedElephant")
-co = get("BM_Clustering_RefinedElephant_Ordered")
+cl = get("BM_Clustering_RefinedElephant", "cpu_time")
+co = get("BM_Clustering_RefinedElephant_Ordered", "cpu_time")
 fnv = runs.get("BM_Clustering_RefinedElephant", [{}])[0].get("cluster_of_fnv24")
-row("three-channel clustering, refined_elephant, rays precomputed, one core (ms)", mm(cl, "ms"),
+row("three-channel clustering, refined_elephant, rays precomputed, one core, CPU (ms)", mm(cl, "ms"),
     "the same mesh in Morton order: " + mm(co, "ms"), ratio(cl, co),
     f"regression: `cluster_of_fnv24` {int(fnv) if fnv is not None else 'n/a'} (7619422 expected)")
 se = get("BM_Saliency_Exact/2/iterations:1/real_time")
@@ -110,8 +107,8 @@ err = runs.get("BM_Saliency_Approx/16/real_time", [{}])[0].get("rel_l2_error")
 row("exact saliency, refined_elephant subdivided (178k vertices), 2 threads, wall (ms)", mm(se, "ms"),
     f"approximate (4 cells per σ, {fmt(err and 100 * err, 2)}% rel. L2 off): " + mm(sa, "ms"),
     ratio(sa, se) + " (approximate / exact)", "exact ≤ 1 s on 2 cores")
-sc = get("BM_SalientClustering/real_time")
-row("salient clustering, bunny00, C = 10 (ms)", mm(sc, "ms"), "—", "—", "≤ 0.5 s; paper 30 s")
+sc = get("BM_SalientClustering/real_time", "cpu_time")
+row("salient clustering, bunny00, C = 10, CPU (ms)", mm(sc, "ms"), "—", "—", "≤ 0.5 s; paper 30 s")
 sd = get("BM_Subdivision_Uniform", "children_per_second")
 row("subdivision, fandisk, 3 levels (children/s)", mm(sd and tuple(x * M for x in sd), "M", largest=True),
     "—", "—", "≥ 2 M/s")
@@ -125,7 +122,8 @@ row("upsampler's own work, 1025², 4 passes, cheap source, one core (ns per pixe
 
 print(f"CPU: {cpu} ({ncpu} cores{', ' + flags.strip() if flags.strip() else ''}); "
       f"load average {load0} before, {load1} after; {reps} repetitions, interleaved. "
-      "Figures: best / median of the repetitions (rates: highest, times: lowest).")
+      "Figures: best / median of the repetitions (rates: highest, times: lowest); "
+      "one-core rates and times are CPU time, rows marked wall are wall time.")
 print()
 print("| what | measured | reference, same run | ratio (best, median) | goal |")
 print("|---|---|---|---|---|")
