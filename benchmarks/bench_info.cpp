@@ -1,13 +1,10 @@
-// Jensen–Shannon throughput (issue 2 goal: at least 200 million bins/s per core for double) next
+// Jensen–Shannon throughput (goal: at least 200 million bins/s per core for double) next
 // to a naive std::log2 baseline, and validate_mesh throughput on refined_elephant.
 //   build/benchmarks/infolerp_bench --benchmark_filter='JensenShannon|ValidateMesh'
 // BM_JensenShannon_Column/<bins>/<estimate>: one row against 4096 rows (a seed's JS column, as
 // the clustering evaluates it), exact kernel (0) or js_estimate (1), with the estimate's worst
 // error over the column against its bound. 64 float bins are the visibility channel's rows,
-// 257 double bins the binned direct channels'. Measured (CPU, one core of the shared 2-core AMD
-// EPYC dev VM, 2026-12-02): 64 float bins 639 ns exact, 104 ns estimate (6.2x), worst error
-// 3.8e-7 against the bound 2.6e-5; 257 double bins 2.20 µs exact, 593 ns estimate (3.7x: the
-// conversion to float), worst 8.0e-7 against 6.4e-5.
+// 257 double bins the binned direct channels'. Figures: benchmarks/NOTES.md.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -1,14 +1,10 @@
-// Mesh saliency and salient clustering (issue 4).
+// Mesh saliency and salient clustering.
 // Goals: BM_Saliency_Exact on refined_elephant subdivided once 1:4 (~178k vertices) <= 1.0 s
 // wall on 2 cores; BM_Saliency_Approx <= 0.1 s at <= 1% relative L2 error against exact
 // (the time-against-error table: counters rel_l2_error and seconds, one row per
 // approx_cells_per_sigma setting);
 // BM_SalientClustering on bunny00 with C = 10 <= 0.5 s.
-// Measured on the 2-core Intel Xeon VM (AVX-512), runs taken while vmstat showed both cores idle
-// (the VM is shared; under load the 2-thread wall time doubles): BM_Saliency_Exact/2 0.950 and
-// 0.925 s wall (goal met, ~5-7% margin; 0.98 and 1.01 s one commit earlier, with the column
-// sorts and the final scatter still serial), BM_Saliency_Exact/1 1.78 and 1.69 s (was 3.9-4.1 s
-// before the pair-once kernel); BM_SalientClustering 0.360-0.370 s (goal met; 16 rounds).
+// Figures: benchmarks/NOTES.md.
 // Google Benchmark's CPU column counts the main thread only: with 2 threads, compare wall times.
 #include <benchmark/benchmark.h>
 

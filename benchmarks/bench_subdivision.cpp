@@ -1,5 +1,5 @@
 // Subdivision throughput (refine/subdivision_mesh.hpp) on CGAL's fandisk (12,946 triangles).
-// Goal (issue 5): at least 2 million child triangles per second on one core.
+// Goal: at least 2 million child triangles per second on one core.
 //  BM_Subdivision_Uniform:          every leaf selected, 3 levels (closure only) -> 64x the mesh
 //  BM_Subdivision_RandomSelections: 20,000 random leaf selections with the default propagation
 // Building the roots is excluded from the timing; `children_per_second` counts every triangle

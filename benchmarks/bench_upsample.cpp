@@ -1,4 +1,4 @@
-// Cost of the I-Buffer upsampler's own work (issue 6): interpolation, re-use, compatibility tests,
+// Cost of the I-Buffer upsampler's own work: interpolation, re-use, compatibility tests,
 // shading into the frame buffer, with a cheap synthetic sample source so that evaluation costs
 // almost nothing. Goal: at most 20 ns per interpolated pixel on one core. The cheap_probe_source
 // rows add a probe per new sample (as cheap as the evaluation here); cheap_refining_source's

@@ -18,26 +18,8 @@
 // Beside the CSV: FILE.png (PSNR against shading samples, one line per criterion, gnuplot),
 // FILE.gp (its script) and FILE_{reference,stage1,NLD_OS,NLD_IS,RND}.png (the final images).
 //
-// Measured (320x240, R = 64, S_req = 0.05, 6-pixel rule, always-refine 2%, RND 1.0 x pixels):
-// NLD_OS stops by its rule at 32.39 dB with 2,041 samples; RND's final image is 32.43 dB at
-// 15,014 samples, and RND first reaches 32.39 dB there (14,503 samples give 32.37 dB), so
-// NLD_OS needs 13.6% of RND's samples for its own final PSNR but never reaches RND's final
-// PSNR (goal: <= 25% of RND's samples at RND's final PSNR; missed by 0.04 dB). Why: on this
-// scene both criteria end at the same floor, the 6-pixel rule. 97% of NLD_OS's remaining
-// squared error (96% of RND's) lies in leaves under 6 pixels that straddle a shadow edge
-// (S > S_req); RND's 1:4 edge leaves end a little finer (2.40 against 2.50 pixels on
-// average) because its refinement of every larger leaf propagates 1:4 splits into them. S is 0 or far
-// above any usable S_req here (flat Lambert ground, hard shadows), so S_req from 0 to 0.5
-// gives the identical NLD_OS run. Things that move either floor by a few hundredths of a dB
-// without a trend, so none is a fair fix: RND's seed (final 32.43-32.49 dB over seeds 1-8),
-// propagation_depth (NLD_OS minus RND final PSNR: -0.04, +0.03, -0.03, -0.06 dB at depths
-// 1-4), always_refine_fraction 0.01-0.0002 (NLD_OS 32.36-32.42 dB). Other sizes, same gap
-// sign: NLD_OS final / RND final = 31.66 / 32.79 dB at 160x120, 36.35 / 36.47 at 480x360,
-// 38.41 / 39.23 at 640x480 (NLD_OS at 22%, 10%, 7% of RND's samples).
-// The sweep printed last (RND to completion at point fractions 0.05-1.0; NLD_OS run to budgets
-// 25 samples apart): RND 8,891 samples / 31.49 dB at 0.05, 12,230 / 32.21 at 0.1, 14,428 / 32.37
-// at 0.2, reached by NLD_OS with 1,813 (20.4%), 2,016 (16.5%) and 2,036 (14.1%) samples; from 0.3
-// up RND ends at its floor, 15,014 / 32.43 dB, which NLD_OS never reaches.
+// Results and why NLD_OS stops short of RND's final PSNR: benchmarks/NOTES.md (infolerp_pareto
+// refine).
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -1,7 +1,7 @@
 // infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N]
 //                          [--size W H] [--threads N] [--ao N] [--soft N]
 //
-// Time against error of the I-Buffer upsampler (issue 6) and its competitors on the demo scene
+// Time against error of the I-Buffer upsampler and its competitors on the demo scene
 // (1025x1025 by default) with the reference shader (AO 64 rays, soft shadow 16 rays, hard-shadow
 // sun, textures; fixed ray sets, so the reference is exactly reproducible). Methods, in one run:
 //   full_single       full per-pixel evaluation, single rays (the reference, error 0)

@@ -1,40 +1,49 @@
 #pragma once
-// Umbrella header, for convenience only: every infolerp header compiles on its own.
-#include "infolerp/cluster/boundary_smoothing.hpp"
-#include "infolerp/cluster/channel.hpp"
-#include "infolerp/cluster/cluster_mesh.hpp"
-#include "infolerp/cluster/orientation_channel.hpp"
-#include "infolerp/cluster/region_growing.hpp"
-#include "infolerp/cluster/stretch_channel.hpp"
-#include "infolerp/cluster/visibility_channel.hpp"
-#include "infolerp/core/executor.hpp"
-#include "infolerp/core/large_buffer.hpp"
+// Umbrella header, for convenience only: every infolerp header compiles on its own, and a
+// translation unit that includes only the headers it uses parses less.
+
+// Entry points: what an engine calls.
+#include "infolerp/cluster/cluster_mesh.hpp"             // Algorithm 1: cluster ids per triangle
+#include "infolerp/saliency/mesh_saliency.hpp"           // saliency per vertex (Lee et al.)
+#include "infolerp/saliency/salient_clustering.hpp"      // salient clusters, cluster-localised saliency
+#include "infolerp/saliency/cluster_importance.hpp"      // view-dependent importance and budgets
+#include "infolerp/lod/view_dependent_lod.hpp"           // per-frame saliency LOD into an index buffer
+#include "infolerp/refine/progressive_driver.hpp"        // progressive refinement (NLD_OS, NLD_IS, RND)
+#include "infolerp/upsample/upsampler.hpp"               // the I-Buffer upsampler
+#include "infolerp/upsample/pass_controller.hpp"         // automatic pass count
+#include "infolerp/mesh/validate.hpp"                    // mesh checks
+#include "infolerp/mesh/locality_order.hpp"              // Morton order of triangles
+
+// What you implement (or adapt): mesh, tracer, job system, sample source.
 #include "infolerp/core/mesh_traits.hpp"
-#include "infolerp/core/random.hpp"
-#include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
+#include "infolerp/core/executor.hpp"
+#include "infolerp/upsample/sample_source.hpp"
+#include "infolerp/mesh/adaptors.hpp"                    // ready mesh types and views
+
+// Building blocks: channels, one-channel clustering, information theory, geometry, refinement.
+#include "infolerp/cluster/channel.hpp"
+#include "infolerp/cluster/visibility_channel.hpp"
+#include "infolerp/cluster/orientation_channel.hpp"
+#include "infolerp/cluster/stretch_channel.hpp"
+#include "infolerp/cluster/region_growing.hpp"
+#include "infolerp/cluster/boundary_smoothing.hpp"
 #include "infolerp/info/entropy.hpp"
 #include "infolerp/info/jensen_shannon.hpp"
 #include "infolerp/info/js_estimate.hpp"
 #include "infolerp/info/log2.hpp"
-#include "infolerp/lod/cluster_split.hpp"
-#include "infolerp/lod/contraction_hierarchy.hpp"
-#include "infolerp/lod/vertex_contraction.hpp"
-#include "infolerp/lod/view_dependent_lod.hpp"
-#include "infolerp/lod/view_selection.hpp"
-#include "infolerp/lod/weighting_map.hpp"
-#include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/curvature.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
-#include "infolerp/mesh/validate.hpp"
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
-#include "infolerp/refine/progressive_driver.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
-#include "infolerp/saliency/cluster_importance.hpp"
-#include "infolerp/saliency/mesh_saliency.hpp"
-#include "infolerp/saliency/salient_clustering.hpp"
-#include "infolerp/upsample/pass_controller.hpp"
-#include "infolerp/upsample/sample_source.hpp"
-#include "infolerp/upsample/upsampler.hpp"
+#include "infolerp/lod/weighting_map.hpp"
+#include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/view_selection.hpp"
+#include "infolerp/lod/vertex_contraction.hpp"
+#include "infolerp/lod/cluster_split.hpp"
+#include "infolerp/mesh/support_function.hpp"
+#include "infolerp/core/status.hpp"
+#include "infolerp/core/random.hpp"
+#include "infolerp/core/large_buffer.hpp"

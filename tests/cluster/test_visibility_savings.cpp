@@ -70,12 +70,12 @@ void require_exact_savings(const indexed_mesh& m, std::uint32_t viewpoints, std:
     }
   // How many rays cull_hull skips, from the ray builder itself.
   const visibility_setup su = visibility_channel{.viewpoints = viewpoints, .samples_per_side = n}.setup(m);
-  const visibility_hull hull = make_visibility_hull(m, su);
+  const detail::visibility_hull hull = detail::make_visibility_hull(m, su);
   std::vector<std::uint32_t> tris(m.triangles.size()), slots, freed;
   for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = static_cast<std::uint32_t>(t);
   std::vector<ray> rays;
   std::vector<glm::dvec3> scratch;
-  make_grouped_visibility_rays(m, su, tris, true, &hull, scratch, rays, slots, freed);
+  detail::make_grouped_visibility_rays(m, su, tris, true, &hull, scratch, rays, slots, freed);
   free_rays = freed.size();
   INFO("rays proven free: " << free_rays << " of " << free_rays + rays.size());
   REQUIRE((free_rays > 0) == expect_culled);

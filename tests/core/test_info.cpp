@@ -175,11 +175,11 @@ TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
     };
     (void)same;
 #ifdef INFOLERP_JS_AVX2
-    if (js_cpu_has_avx2())
+    if (x86_vector_level() >= 1)
       same(js_kernel_avx2<false>(a, b, n, wp, 1.0, 1.0, 1.0, 1.0), js_kernel_avx2<true>(a, b, n, wp, 0x1p-3, 8.0, 2.0, 0.5));
 #endif
 #ifdef INFOLERP_JS_AVX512
-    if (js_cpu_has_avx512())
+    if (x86_vector_level() == 2)
       same(js_kernel_avx512<false>(a, b, n, wp, 1.0, 1.0, 1.0, 1.0), js_kernel_avx512<true>(a, b, n, wp, 0x1p-3, 8.0, 2.0, 0.5));
 #endif
   };
@@ -220,13 +220,13 @@ TEST_CASE("log2 estimate: every float in [sqrt(1/2), sqrt(2)) within log2_estima
   // Each compiled copy the CPU can run, not only the one dispatched.
   std::vector<float> other(x.size());
 #ifdef INFOLERP_JSE_AVX2
-  if (jse_cpu_has_avx2_fma()) {
+  if (x86_vector_level() >= 1) {
     log2_estimate_avx2(x.data(), other.data(), x.size());
     CHECK(static_cast<double>(worst(other)) <= infolerp::log2_estimate_error);
   }
 #endif
 #ifdef INFOLERP_JSE_AVX512
-  if (js_cpu_has_avx512()) {
+  if (x86_vector_level() == 2) {
     log2_estimate_avx512(x.data(), other.data(), x.size());
     CHECK(static_cast<double>(worst(other)) <= infolerp::log2_estimate_error);
   }
@@ -264,10 +264,10 @@ TEST_CASE("JS estimate: within js_estimate_error of the exact kernel on every sh
     };
     through(infolerp::detail::xlogx_sum_on<infolerp::detail::jse_vf, infolerp::detail::jse_vi, T>);
 #ifdef INFOLERP_JSE_AVX2
-    if (infolerp::detail::jse_cpu_has_avx2_fma()) through(infolerp::detail::xlogx_sum_avx2<T>);
+    if (infolerp::detail::x86_vector_level() >= 1) through(infolerp::detail::xlogx_sum_avx2<T>);
 #endif
 #ifdef INFOLERP_JSE_AVX512
-    if (infolerp::detail::js_cpu_has_avx512()) through(infolerp::detail::xlogx_sum_avx512<T>);
+    if (infolerp::detail::x86_vector_level() == 2) through(infolerp::detail::xlogx_sum_avx512<T>);
 #endif
   };
   for (std::size_t n : {1u, 2u, 7u, 8u, 15u, 16u, 17u, 63u, 64u, 65u, 257u, 1000u, 4096u}) {

@@ -15,23 +15,8 @@
 // uses the cell's mean normal as its own (angular error up to about half a cell diagonal,
 // ≈ 2.5/√K rad before the octahedral map's up-to-2× area distortion), and (2) the entries inside
 // a cell are taken as equal, which can only lower JS (data-processing inequality). Exact rows
-// keep only (2). Measured (BM_OrientationChannel, CGAL's fandisk, 12,946 triangles, Th = 0.02,
-// CPU time of init + region growing, load 3.5; exact 1.52 s):
-//   K = 64 / 256 / 1024 / 4096, per-cell rows: mean |ΔJS| 7.9e-3 / 3.5e-3 / 1.7e-3 / 8.5e-4,
-//     adjusted Rand index against exact 0.915 / 0.908 / 0.954 / 0.965, 0.5–3.3 ms;
-//   exact rows: mean |ΔJS| 2.3e-3 / 4.2e-4 / 9.6e-5 / 2.4e-5, ARI 0.976 / 0.994 / 0.997 /
-//     0.9997, 10.5 / 16.1 / 29.4 / 60.4 ms (K = 1024: 52× less time than exact).
-// On the jittered 2304-triangle torus (BM_OrientationChannel_Torus) K = 1024 leaves 786 cells
-// for 2304 normals, no binning regime: exact rows ARI 0.83 at 3× less time, per-cell rows 0.49.
-// On CGAL's bunny00 (75,408 triangles of a scan, 155 clusters; exact 803 s at load 4.5) exact
-// rows give ARI 0.46 / 0.51 / 0.49 / 0.85 at 1,600× / 440× / 111× / 17× less time (per-cell
-// rows 0.32–0.47). How well-posed agreement is depends on the mesh: exact against exact at a
-// threshold 1% higher gives ARI 0.994 on fandisk but 0.72 on the torus (1.0 at 1e-4) and 0.48
-// on bunny00 (as low as binning's 0.49 there): where clusters have no natural borders, a JS
-// error of 1% of Th already moves them.
-// Per-cell rows are the fast choice inside Algorithm 1 (refined_elephant with bins = 256: exact
-// rows for orientation and stretch take 0.81 s against 0.30 s, and give 1815 / 3986 clusters
-// after those channels against 1960 / 4248).
+// keep only (2). Per-cell rows are the fast choice inside Algorithm 1; exact rows agree with
+// exact more closely at U rows' cost (benchmarks/NOTES.md, BM_OrientationChannel).
 // Degenerate cases: a planar set is one class (all alike: one cluster, no work); a zero-area
 // triangle's normal is (0,0,0) (mesh/geometry.hpp), its own class with a uniform row.
 #include <algorithm>

@@ -19,13 +19,10 @@
 // cell's mass Σ(1 − |s_a − s|) exact by prefix sums (also the cell holding s_a), O(C) per row.
 // Binned error: per-cell rows replace the triangle's own value by its cell's mean (error <=
 // 1/K), over-estimate the own cell's mass by at most count/K, and take the entries inside a cell
-// as equal (which can only lower JS); exact rows keep only the last. Measured (BM_StretchChannel,
-// 64×32 UV sphere, 3,968 triangles, Th = 0.005, CPU, load 3.5; exact 211 ms): per-cell rows
-// mean |ΔJS| 8.5e-4 / 8.3e-5 / 4.4e-5 / 4.4e-5 for K = 64 / 256 / 1024 / 4096, and near S = 1
-// the row entries 1 − |ΔS| of the least stretched triangles are tiny, so the 1/K shift of the
-// own value changes them by large factors: 2 clusters against exact's 42 (adjusted Rand index
-// 0.66). Exact rows: mean |ΔJS| 6.8e-4 / 4.6e-5 / 1.2e-7 / 1.2e-7, exact's 42 clusters (ARI 1)
-// at every K, 1.0–1.5 ms (K = 1024: 187× less time than exact).
+// as equal (which can only lower JS); exact rows keep only the last. Per-cell rows can move
+// clusters a lot where S is near 1 (the row entries 1 − |ΔS| of the least stretched triangles
+// are tiny, so a 1/K shift of the own value changes them by large factors); exact rows agree
+// with exact at a fraction of its time (benchmarks/NOTES.md, BM_StretchChannel).
 // Meshes without texcoords: prepare() succeeds and skip_reason() says the channel is skipped.
 #include <algorithm>
 #include <cmath>

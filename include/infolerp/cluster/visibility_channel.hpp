@@ -109,7 +109,9 @@ struct visibility_setup {
 
 // Appends the occlusion rays of triangles [first, last) to `rays`, and for each ray its slot
 // (t − first)·N + v to `slots`. Back-facing sample/viewpoint pairs get no ray (OR term 0).
-// Exposed so that benchmarks can time the same rays alone. O((last − first)·N·n²).
+// In detail: not part of the API; benchmarks call it to time the same rays alone.
+// O((last − first)·N·n²).
+namespace detail {
 template <class M>
 void make_visibility_rays(const M& m, const visibility_setup& setup, std::size_t first, std::size_t last,
                           std::vector<ray>& rays, std::vector<std::uint32_t>& slots) {
@@ -219,6 +221,8 @@ void make_grouped_visibility_rays(const M& m, const visibility_setup& setup, std
           for (std::size_t v = 0; v < nv; ++v) emit(i, s, v);
   }
 }
+
+}  // namespace detail
 
 // A visibility channel initialised on a set of triangles. Classes are elements.
 class visibility_state {
@@ -600,7 +604,7 @@ struct visibility_channel {
       order.resize(nt);
       for (std::size_t t = 0; t < nt; ++t) order[t] = static_cast<std::uint32_t>(t);
     }
-    const visibility_hull hull = cull_hull ? make_visibility_hull(m, su) : visibility_hull{};
+    const detail::visibility_hull hull = cull_hull ? detail::make_visibility_hull(m, su) : detail::visibility_hull{};
     const std::size_t chunks = chunk_count(nt, g), per_wave = 64;
     for (std::size_t w0 = 0; w0 < chunks; w0 += per_wave) {
       const std::size_t w1 = std::min(chunks, w0 + per_wave);
@@ -616,7 +620,7 @@ struct visibility_channel {
           rays.clear();
           slots.clear();
           if (!grouped) {
-            make_visibility_rays(m, su, first, last, rays, slots);
+            detail::make_visibility_rays(m, su, first, last, rays, slots);
             hit.resize(rays.size());
             trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
             std::uint8_t* out = p.visible.data() + first * nv;
@@ -626,9 +630,9 @@ struct visibility_channel {
           free_slots.clear();
           const std::span<const std::uint32_t> tris(order.data() + first, last - first);
           auto count = [&](std::uint32_t slot) { ++p.visible[std::size_t{tris[slot / nv]} * nv + slot % nv]; };
-          const visibility_hull* h = cull_hull ? &hull : nullptr;
+          const detail::visibility_hull* h = cull_hull ? &hull : nullptr;
           if (probes > 0) {  // the probes, then the rest where they disagree
-            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, probe_on);
+            detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, probe_on);
             hit.resize(rays.size());
             trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
             faced.assign(tris.size() * nv, 0);
@@ -647,9 +651,9 @@ struct visibility_channel {
             rays.clear();
             slots.clear();
             free_slots.clear();
-            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, rest_on, mode);
+            detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, rest_on, mode);
           } else {
-            make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots);
+            detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots);
           }
           hit.resize(rays.size());
           trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));

@@ -4,10 +4,8 @@
 // first touch costs one page fault per 2 MiB instead of one per 4 KiB where transparent huge
 // pages are enabled ("always" or "madvise"); a hint only, without effect on values. Below 4 MiB,
 // plain operator new; elsewhere than Linux, aligned operator new without the hint.
-// Measured on refined_elephant's clustering (AMD EPYC VM with AVX-512, THP "madvise"): the two
-// 22.8 MB row buffers of each run faulted 4 KiB pages for ~10% of the run; with this allocator
-// page faults 159k -> 32k per benchmark process and the run 181-188 -> 161-162 ms
-// (BM_Clustering_RefinedElephant, alternating runs).
+// The visibility channel's two row buffers faulted 4 KiB pages for about a tenth of the
+// clustering run (benchmarks/NOTES.md, BM_Clustering_RefinedElephant).
 //
 //   std::vector<float, infolerp::large_buffer_allocator<float>> rows;
 #include <cstddef>

@@ -14,12 +14,8 @@
 // __builtin_cpu_supports; define INFOLERP_NO_RUNTIME_DISPATCH to keep the SSE2 one,
 // INFOLERP_NO_AVX512 to stop at AVX2. Bins are processed in blocks in two stages (ratios and
 // divisions, then polynomials) so that out-of-order cores overlap them; a bin takes two
-// divisions (1/m, and one for both atanh arguments). Measured (BM_JensenShannon*,
-// benchmarks/bench_info.cpp, CPU time, one core of the shared 2-core dev VM at load 1.7,
-// portable flags, AVX-512 dispatched): about 420 million bins/s for double rows, 390 million
-// for float rows (the previous AVX2 kernel with three divisions per bin: 350 / 340 million in
-// the same runs; std::log2 per bin: about 88 million); a 64-bin float row pair (the
-// visibility channel) about 158 ns (was 189), a 257-bin double pair about 660 ns (was 748).
+// divisions (1/m, and one for both atanh arguments). Throughput beside std::log2 per bin:
+// benchmarks/NOTES.md (BM_JensenShannon).
 // Other compilers get the same arithmetic one bin at a time. Four accumulators, combined as
 // (a0+a1)+(a2+a3), bin i going to a_(i mod 4) (8-lane vectors add their two halves in turn):
 // the result is bit-identical for every vector width, so the dispatch never changes a result
@@ -37,6 +33,7 @@
 #include <string>
 #include <type_traits>
 #include <vector>
+#include "infolerp/core/detail/cpu.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/info/log2.hpp"
 
@@ -46,7 +43,6 @@ namespace detail {
 
 #if defined(__GNUC__) && !defined(INFOLERP_NO_VECTOR_EXTENSIONS)
 #define INFOLERP_JS_VECTOR 1
-#define INFOLERP_JS_INLINE __attribute__((always_inline)) inline  // compiled into each ISA version
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // vectors only pass between inlined helpers
 #if defined(__clang__)
@@ -68,7 +64,6 @@ using js_vu = js_v2u;
 #define INFOLERP_JS_UNROLL _Pragma("GCC unroll 2")
 #else
 #define INFOLERP_JS_VECTOR 0
-#define INFOLERP_JS_INLINE inline
 using js_vd = double;
 using js_vu = std::uint64_t;
 #define INFOLERP_JS_UNROLL
@@ -83,7 +78,7 @@ struct js_stage {
   D pa, pb, k, sa, sb;
 };
 template <class D, class U>
-INFOLERP_JS_INLINE void js_prepare(js_stage<D>& s, const D& a, const D& b, double wp, double wq) noexcept {
+INFOLERP_FORCE_INLINE void js_prepare(js_stage<D>& s, const D& a, const D& b, double wp, double wq) noexcept {
   // All-ones where a != b: equal bins contribute exactly 0.
 #if INFOLERP_JS_VECTOR
   const U keep = INFOLERP_BIT_CAST(U, a != b);
@@ -107,7 +102,7 @@ INFOLERP_JS_INLINE void js_prepare(js_stage<D>& s, const D& a, const D& b, doubl
 // a_(i mod 4)): vectors of up to 4 lanes add into acc[v mod (4/lanes)], 8-lane vectors add
 // their low then their high half into one 4-lane acc (the same additions in the same order).
 template <class D, class A, std::size_t N>
-INFOLERP_JS_INLINE void js_finish(A (&acc)[N], std::size_t v, const js_stage<D>& s) noexcept {
+INFOLERP_FORCE_INLINE void js_finish(A (&acc)[N], std::size_t v, const js_stage<D>& s) noexcept {
   D la, lb;
   log_atanh_series(la, s.sa);
   log_atanh_series(lb, s.sb);
@@ -123,7 +118,7 @@ INFOLERP_JS_INLINE void js_finish(A (&acc)[N], std::size_t v, const js_stage<D>&
 
 // Loads `count` (< lanes allowed: zero-padded) entries as doubles, times scale (pre, then inv).
 template <bool Scaled, class D, class T>
-INFOLERP_JS_INLINE void js_load(D& v, const T* x, std::size_t count, double pre, double inv) noexcept {
+INFOLERP_FORCE_INLINE void js_load(D& v, const T* x, std::size_t count, double pre, double inv) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double);
 #if INFOLERP_JS_VECTOR
   if (count < lanes) {
@@ -148,7 +143,7 @@ INFOLERP_JS_INLINE void js_load(D& v, const T* x, std::size_t count, double pre,
 // Scaled: entries are first multiplied by pre_* then inv_* (normalisation without overflow,
 // see jensen_shannon).
 template <class D, class U, bool Scaled, class T>
-INFOLERP_JS_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, double wp, double pre_p, double inv_p,
+INFOLERP_FORCE_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, double wp, double pre_p, double inv_p,
                                        double pre_q, double inv_q) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double);
   const double wq = 1.0 - wp;
@@ -196,16 +191,12 @@ INFOLERP_JS_INLINE double js_kernel_on(const T* p, const T* q, std::size_t n, do
 // Runtime dispatch (x86-64, GCC/Clang, not already compiled for AVX2): the same kernel on
 // 4-lane vectors in a function compiled for AVX2 (no FMA: the arithmetic, and so every bit of
 // the result, is the portable kernel's). Define INFOLERP_NO_RUNTIME_DISPATCH to disable.
-#if INFOLERP_JS_VECTOR && defined(__x86_64__) && !defined(__AVX2__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
+#if INFOLERP_JS_VECTOR && defined(INFOLERP_X86_DISPATCH) && !defined(__AVX2__)
 #define INFOLERP_JS_AVX2 1
 template <bool Scaled, class T>
 __attribute__((target("avx2"))) double js_kernel_avx2(const T* p, const T* q, std::size_t n, double wp, double pre_p,
                                                       double inv_p, double pre_q, double inv_q) noexcept {
   return js_kernel_on<js_v4d, js_v4u, Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
-}
-inline bool js_cpu_has_avx2() noexcept {
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
 }
 // And on 8-lane vectors where the CPU has AVX-512F (define INFOLERP_NO_AVX512 to disable).
 // AVX-512F implies FMA, and GCC and Clang would contract a·b + c into it (other bits than the
@@ -223,10 +214,6 @@ double js_kernel_avx512(const T* p, const T* q, std::size_t n, double wp, double
                         double inv_q) noexcept {
   return js_kernel_on<js_v8d, js_v8u, Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 }
-inline bool js_cpu_has_avx512() noexcept {
-  static const bool yes = __builtin_cpu_supports("avx512f");
-  return yes;
-}
 #endif
 #endif
 
@@ -234,10 +221,10 @@ template <bool Scaled, class T>
 double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p = 1.0, double inv_p = 1.0,
                  double pre_q = 1.0, double inv_q = 1.0) noexcept {
 #ifdef INFOLERP_JS_AVX512
-  if (js_cpu_has_avx512()) return js_kernel_avx512<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
+  if (x86_vector_level() == 2) return js_kernel_avx512<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 #endif
 #ifdef INFOLERP_JS_AVX2
-  if (js_cpu_has_avx2()) return js_kernel_avx2<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
+  if (x86_vector_level() >= 1) return js_kernel_avx2<Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 #endif
   return js_kernel_on<js_vd, js_vu, Scaled>(p, q, n, wp, pre_p, inv_p, pre_q, inv_q);
 }
@@ -246,7 +233,7 @@ double js_kernel(const T* p, const T* q, std::size_t n, double wp, double pre_p 
 // contribute exactly 0), clamped at 0; each term as p·log2_accurate(p/q), summed like
 // js_kernel_on (4 accumulators, bit-identical for every vector width). Used for I(x;Y).
 template <class D, class U, class T>
-INFOLERP_JS_INLINE double kl_kernel_on(const T* p, const double* q, std::size_t n) noexcept {
+INFOLERP_FORCE_INLINE double kl_kernel_on(const T* p, const double* q, std::size_t n) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double), accumulators = 4 / lanes;
   D acc[accumulators] = {};
   D a, b, one, ln;
@@ -277,7 +264,7 @@ INFOLERP_JS_INLINE double kl_kernel_on(const T* p, const double* q, std::size_t 
 // log₂e·Σ_i (p_i − q_i) over the bins with p_i > 0 and q_i > 0: a lower bound of kl_kernel
 // without logarithms (p·ln(p/q) >= p − q), summed like kl_kernel_on.
 template <class D, class U, class T>
-INFOLERP_JS_INLINE double kl_lower_bound_on(const T* p, const double* q, std::size_t n) noexcept {
+INFOLERP_FORCE_INLINE double kl_lower_bound_on(const T* p, const double* q, std::size_t n) noexcept {
   constexpr std::size_t lanes = sizeof(D) / sizeof(double), accumulators = 4 / lanes;
   D acc[accumulators] = {};
   D a, b;
@@ -301,13 +288,13 @@ INFOLERP_JS_INLINE double kl_lower_bound_on(const T* p, const double* q, std::si
 // portable ones (bit-identical, the same summation order).
 struct kl_sum {
   template <class D, class U, class T>
-  INFOLERP_JS_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
+  INFOLERP_FORCE_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
     return kl_kernel_on<D, U>(p, q, n);
   }
 };
 struct kl_bound {
   template <class D, class U, class T>
-  INFOLERP_JS_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
+  INFOLERP_FORCE_INLINE static double run(const T* p, const double* q, std::size_t n) noexcept {
     return kl_lower_bound_on<D, U>(p, q, n);
   }
 };
@@ -320,7 +307,7 @@ __attribute__((target("avx2"))) double kl_dispatch_avx2(const T* p, const double
 template <class K, class T>
 double kl_dispatch(const T* p, const double* q, std::size_t n) noexcept {
 #ifdef INFOLERP_JS_AVX2
-  if (js_cpu_has_avx2()) return kl_dispatch_avx2<K>(p, q, n);
+  if (x86_vector_level() >= 1) return kl_dispatch_avx2<K>(p, q, n);
 #endif
   return K::template run<js_vd, js_vu>(p, q, n);
 }

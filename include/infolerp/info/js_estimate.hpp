@@ -28,14 +28,9 @@
 // Speed: the portable build runs 8-float GNU vectors on SSE2; on x86-64 an AVX2+FMA copy and a
 // 16-float AVX-512F copy are chosen at run time (the bound holds for each, and each is tested;
 // their bits may differ, which is why results never depend on an estimate's value, only on
-// decisions it proves). Measured (BM_JensenShannon_Column_*, benchmarks/bench_info.cpp, one
-// row against 4096): on the AMD EPYC VM without AVX-512 (AVX2+FMA), a 64-bin float row pair
-// 104 ns against 639 ns exact (6.2x), a 257-bin double pair 593 ns against 2.2 µs (3.7x: the
-// conversion to float; the direct channels keep float copies of their rows for this); on the
-// AMD EPYC VM with AVX-512 of 2026-12-02, 64 float bins 24.4 -> 19.8-20.9 ns with the AVX-512 copy
-// (exact 92 ns), 257 double bins 650 -> 353 ns (exact 339 ns, itself on AVX-512: for double
-// rows the estimate is no faster there). Worst error seen: 3.8e-7 at 64 bins (bound 2.6e-5),
-// 8.0e-7 at 257 (bound 6.4e-5).
+// decisions it proves). The estimate pays off for float rows (the direct channels keep float
+// copies of their rows for it); for double rows the conversion eats most of the gain
+// (benchmarks/NOTES.md, BM_JensenShannon_Column).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -74,7 +69,7 @@ using jse_vi = std::int32_t;
 // out = k + P(f − 1) ≈ log₂x (x = 2^k·f, f in [√½, √2)); finite for x = 0 (−127) and
 // subnormal x (within 24 of log₂x); x·out is what callers use.
 template <class V, class I>
-INFOLERP_LOG2_INLINE void log2_estimate_on(V& out, const V& x) noexcept {
+INFOLERP_FORCE_INLINE void log2_estimate_on(V& out, const V& x) noexcept {
   const I bits = INFOLERP_BIT_CAST(I, x);
   const I t = bits - 0x3F3504F3;  // the bits of √½ (rounded down)
 #if INFOLERP_JSE_VECTOR
@@ -93,7 +88,7 @@ INFOLERP_LOG2_INLINE void log2_estimate_on(V& out, const V& x) noexcept {
 
 // Loads one vector of entries as floats.
 template <class V, class T>
-INFOLERP_LOG2_INLINE void jse_load(V& v, const T* x) noexcept {
+INFOLERP_FORCE_INLINE void jse_load(V& v, const T* x) noexcept {
   if constexpr (std::is_same_v<T, float>) {
     std::memcpy(&v, x, sizeof v);
 #if INFOLERP_JSE_VECTOR
@@ -116,7 +111,7 @@ INFOLERP_LOG2_INLINE void jse_load(V& v, const T* x) noexcept {
 
 // Σ_i x_i·log₂x_i (<= 0) over x_i = wp·p_i + wq·q_i (float), or x_i = p_i when q is null.
 template <class V, class I, class T>
-INFOLERP_LOG2_INLINE double xlogx_sum_on(const T* p, const T* q, std::size_t n, float wp, float wq) noexcept {
+INFOLERP_FORCE_INLINE double xlogx_sum_on(const T* p, const T* q, std::size_t n, float wp, float wq) noexcept {
   constexpr std::size_t lanes = sizeof(V) / sizeof(float);
   V acc0 = {}, acc1 = {};
   auto term = [&](V& acc, const T* pi, const T* qi) {
@@ -155,7 +150,7 @@ INFOLERP_LOG2_INLINE double xlogx_sum_on(const T* p, const T* q, std::size_t n, 
 // out[j] = log2_estimate_on(x[j]) for j from i, a vector at a time while one fits; returns
 // where it stopped.
 template <class V, class I>
-INFOLERP_LOG2_INLINE std::size_t log2_estimate_from(const float* x, float* out, std::size_t i, std::size_t n) noexcept {
+INFOLERP_FORCE_INLINE std::size_t log2_estimate_from(const float* x, float* out, std::size_t i, std::size_t n) noexcept {
   for (; i + sizeof(V) / sizeof(float) <= n; i += sizeof(V) / sizeof(float)) {
     V v, l;
     std::memcpy(&v, x + i, sizeof v);
@@ -179,10 +174,6 @@ __attribute__((target("avx2,fma"))) double xlogx_sum_avx2(const T* p, const T* q
 __attribute__((target("avx2,fma"))) inline void log2_estimate_avx2(const float* x, float* out, std::size_t n) noexcept {
   log2_estimate_from<jse_vf, jse_vi>(x, out, 0, n);
 }
-inline bool jse_cpu_has_avx2_fma() noexcept {
-  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return yes;
-}
 #endif
 
 // And on 16 lanes where the CPU has AVX-512F (INFOLERP_NO_AVX512 disables it): half the
@@ -202,10 +193,10 @@ __attribute__((target("avx512f"))) inline void log2_estimate_avx512(const float*
 template <class T>
 double xlogx_sum(const T* p, const T* q, std::size_t n, float wp, float wq) noexcept {
 #ifdef INFOLERP_JSE_AVX512
-  if (js_cpu_has_avx512()) return xlogx_sum_avx512(p, q, n, wp, wq);
+  if (x86_vector_level() == 2) return xlogx_sum_avx512(p, q, n, wp, wq);
 #endif
 #ifdef INFOLERP_JSE_AVX2
-  if (jse_cpu_has_avx2_fma()) return xlogx_sum_avx2(p, q, n, wp, wq);
+  if (x86_vector_level() >= 1) return xlogx_sum_avx2(p, q, n, wp, wq);
 #endif
   return xlogx_sum_on<jse_vf, jse_vi>(p, q, n, wp, wq);
 }
@@ -214,10 +205,10 @@ double xlogx_sum(const T* p, const T* q, std::size_t n, float wp, float wq) noex
 // For the exhaustive accuracy test. O(n), no allocation.
 inline void log2_estimate(const float* x, float* out, std::size_t n) noexcept {
 #ifdef INFOLERP_JSE_AVX512
-  if (js_cpu_has_avx512()) return log2_estimate_avx512(x, out, n);
+  if (x86_vector_level() == 2) return log2_estimate_avx512(x, out, n);
 #endif
 #ifdef INFOLERP_JSE_AVX2
-  if (jse_cpu_has_avx2_fma()) return log2_estimate_avx2(x, out, n);
+  if (x86_vector_level() >= 1) return log2_estimate_avx2(x, out, n);
 #endif
   log2_estimate_from<jse_vf, jse_vi>(x, out, 0, n);
 }

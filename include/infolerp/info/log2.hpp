@@ -10,6 +10,7 @@
 // (never NaN, never a trap); callers multiply it by a weight that is 0 (or below 1e-300) there.
 #include <bit>
 #include <cstdint>
+#include "infolerp/core/detail/cpu.hpp"
 
 namespace infolerp::detail {
 
@@ -18,7 +19,6 @@ namespace infolerp::detail {
 // 256-bit vector passed by value to or from a function compiled without AVX would trip GCC's
 // -Wpsabi in the user's translation unit.
 #if defined(__GNUC__)
-#define INFOLERP_LOG2_INLINE __attribute__((always_inline)) inline
 #define INFOLERP_BIT_CAST(To, x) __builtin_bit_cast(To, x)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // 256-bit vectors only pass between inlined helpers
@@ -26,13 +26,12 @@ namespace infolerp::detail {
 #pragma STDC FP_CONTRACT OFF  // the same bits in the AVX-512 (FMA) kernels, see jensen_shannon.hpp
 #endif
 #else
-#define INFOLERP_LOG2_INLINE inline
 #define INFOLERP_BIT_CAST(To, x) std::bit_cast<To>(x)
 #endif
 
 // out = ln((1+s)/(1-s)) for |s| <= 0.1716. D is double or a GNU vector of doubles.
 template <class D>
-INFOLERP_LOG2_INLINE void log_atanh_series(D& out, const D& s) noexcept {
+INFOLERP_FORCE_INLINE void log_atanh_series(D& out, const D& s) noexcept {
   constexpr double c1 = 6.666666666666735130e-01, c2 = 3.999999999940941908e-01, c3 = 2.857142874366239149e-01,
                    c4 = 2.222219843214978396e-01, c5 = 1.818357216161805012e-01, c6 = 1.531383769920937332e-01,
                    c7 = 1.479819860511658591e-01;
@@ -47,7 +46,7 @@ struct log2_split {
   D k, f;
 };
 template <class D, class U>
-INFOLERP_LOG2_INLINE void log2_reduce(log2_split<D>& out, const D& r) noexcept {
+INFOLERP_FORCE_INLINE void log2_reduce(log2_split<D>& out, const D& r) noexcept {
   constexpr std::uint64_t sqrt_half = 0x3FE6A09E667F3BCDull, exponent = 0xFFF0000000000000ull;
   constexpr std::uint64_t sign = 0x8000000000000000ull;  // flipping it adds 2048 to k (mod 4096)
   constexpr std::uint64_t magic = 0x4330000000000000ull;  // 2^52: a 12-bit integer to double exactly

@@ -1,9 +1,8 @@
 #pragma once
 // Triangles in the order of a Morton (Z-order) curve through their centroids, so that
 // neighbouring triangles sit close together in memory. Mesh files often list faces in no
-// spatial order, and the clustering and saliency loops are bound by memory latency: on
-// refined_elephant, Algorithm 1 took 252 against 301 ms (median) on the reordered mesh
-// (BM_Clustering_RefinedElephant_Ordered against BM_Clustering_RefinedElephant, one run).
+// spatial order, and the clustering and saliency loops are bound by memory latency, so the
+// order alone changes their time (benchmarks/NOTES.md, BM_Clustering_RefinedElephant_Ordered).
 // Salient clustering renumbers its faces with it internally; an engine can apply it to its own
 // meshes before clustering (the clusters then differ only by tie-breaking).
 #include <algorithm>

@@ -43,22 +43,7 @@
 // most); they differ only by FMA contraction (1e-16 relative per operation). Other compilers get
 // a plain 4-double struct. exp(−x) on [0, 2] (the only range the ball cutoff produces) is a
 // polynomial fit, relative error ~1e-16.
-// Measured (refined_elephant subdivided once, 177,852 vertices, 584M unordered pairs within
-// 2σ_max, 750M candidates; 2-core Intel Xeon VM with AVX-512, shared with other jobs; CPU time of
-// the whole call, 1 thread): 1.72–1.80 s AVX-512 (BM_Saliency_Exact/1: 1.74 s), 2.48 s AVX2,
-// 3.94 s portable; the previous kernel (each pair from both ends, AVX2) took 3.9–4.1 s on the
-// same machine (6.3 s on the earlier AMD EPYC VM). Per phase the tiles balance 2 workers to ~3%
-// (simulated from per-tile times), and ~0.12 s of the call is serial (curvature 19 ms, topology
-// 31 ms, point grid 20 ms, normalisation 17 ms, ...): BM_Saliency_Exact/2 took 0.925–0.950 s
-// wall on 2 idle cores (goal 1.0 s). Where the kernel's time goes (AVX-512): exps ~20%, the
-// candidates' sums in memory ~23%. On an AVX2-only machine the 1-thread time is ~1.4× (2.48 s):
-// the 1.0 s goal would be missed there. refined_elephant (44k): 0.18 s CPU AVX-512, 0.23 s AVX2,
-// 0.32 s portable (was 0.35 s AVX2).
-// Tried and not kept (same mesh, CPU time): all three root exps from one exp(−d²·a/100) raised to
-// the powers 100, 144, 225 (runtime exponents: 2.3 s against 1.9 s); candidate blocks bucketed
-// by their σ count so that the σ loop's branch is predictable (4.2 s against 2.6 s); distances
-// computed one block ahead; coordinates interleaved by block; w_8ε = w_12ε²·exp(−x_12ε/4) instead
-// of an exp; columns 2σ_max/2, /4 or /5 wide (all within noise or slower).
+// Measured times per kernel and what was tried instead: benchmarks/NOTES.md (BM_Saliency_Exact).
 //
 // Approximate mode (method = approximate): the ball sums are taken over cell representatives
 // instead of vertices. For each distinct σ the vertices are binned into cells of size
@@ -67,37 +52,9 @@
 // exp(−d²/2σ²)·(count, sum C) over representatives near its ball; a representative straddling
 // the 2σ edge counts with a linear ramp over ±1.5 × its spread (a single vertex keeps the hard
 // cutoff), which removes most of the in/out error of whole cells.
-// Measured relative L2 error of the final saliency against exact: on a 10k-vertex bumpy sphere
-// (tests) 5.0% at 2 cells per σ, 2.0% at 3, 0.11% at 4 (the default); on refined_elephant
-// subdivided once 7.9% at 2, 6.2% at 3, 3.7% at 4, where Lee's local-maxima normalisation
-// amplifies small level errors. On that mesh this mode is no faster than exact (5.5, 8.9 and
-// 11.6 s CPU at 2, 3, 4 cells per σ): it pays off only on small meshes. Re-measured there
-// (BM_Saliency_Approx, 2 threads, load average 2.3–2.7): 9.6% at 1 cell per σ (1.96 s wall),
-// 7.9% at 2 (3.6 s), 6.2% at 3 (4.3 s), 3.7% at 4 (5.8 s), 2.8% at 5 (13.6 s), 1.45% at 6
-// (19.8 s); exact took 6.2 s wall in the same run. The issue's goal (0.1 s at 1%) is not met.
-// Lattice schemes tried instead (branch salapprox, issue 4) and not kept, because they fail the
-// 1% test on the bumpy sphere (lattice spacing h = σ / cells per σ, refined_elephant subdivided
-// once, error = relative L2 of the final saliency against exact, CPU time of the whole call):
-//   - splat–gather–slice: trilinear splat of (1, C), node-to-node ball-truncated Gaussian
-//     (σ_n² = σ² − h²/3), trilinear slice: 11.4% at 1 cell per σ (0.42 s CPU), 9.0% at 2
-//     (1.1 s), 8.8% at 4 (7.4 s), 7.2% at 6 (32 s); bumpy sphere 4.2% at 4.
-//   - exact ball averages at the lattice nodes, trilinear slice: 10.8% at 1 (0.63 s CPU), 9.0%
-//     at 2 (1.5 s), 8.3% at 3 (2.6 s), 7.5% at 4 (4.0 s), 6.4% at 5 (5.2 s), 5.1% at 6 (6.1 s,
-//     as slow as exact); bumpy sphere 8.8% at 4.
-// Both converge slowly because S_i = |G(σ) − G(2σ)| is a small difference of two averages
-// (worst level errors 14–33% on the bumpy sphere), and the hard 2σ cutoff (a step of e⁻² in the
-// kernel) is smeared by any lattice: its error is first order in h/σ.
-// Why the 1% goal is out of reach for any smooth approximation (measured on the same mesh, with
-// the exact ball sums split per vertex into a near part, |x − v| < r0, and a far part): replacing
-// only the far part by its average over each vertex's 1-ring (an optimistic stand-in for any
-// approximation that is smooth at the scale of one vertex spacing, ~0.56ε here) changes the
-// final saliency by 4.5% for r0 = 4ε, 2.3% for r0 = 12ε and 0.34% for r0 = 18ε. The hard 2σ
-// edge makes G(σ) jump as single vertices cross it, and that vertex-scale structure is part of
-// S (averaging the final saliency itself over 1-rings changes it by 1.4%). Staying within 1%
-// therefore needs exact pair sums out to ~18ε, 56% of the pairs within 2σ_max = 24ε: at most
-// ~1.8× faster than exact, never 10×. For scale: exact itself moves by 0.24% when ε changes by
-// 1e-4 relative, 0.41% at 1e-3, 1.0% at 1e-2, and by 0.28% under a position jitter of 1e-5 of
-// the diagonal.
+// Its error against exact is a few per cent on large meshes, where it is no faster than exact;
+// the hard 2σ edge keeps any smooth approximation from 1% (benchmarks/NOTES.md,
+// BM_Saliency_Approx).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -109,6 +66,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/cpu.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
@@ -141,11 +99,6 @@ struct mesh_saliency {
 
 namespace detail {
 
-#if defined(__GNUC__) || defined(__clang__)
-#define INFOLERP_SALIENCY_INLINE __attribute__((always_inline)) inline  // compiled into each ISA version
-#else
-#define INFOLERP_SALIENCY_INLINE inline
-#endif
 
 // x ← exp(−x) for x in [0, 2] (the only range the 2σ ball cutoff produces), for double or a
 // vector of doubles: q(x)⁴ with q the degree-10 Chebyshev fit of exp(−x/4) on [0, 2]. Relative
@@ -153,7 +106,7 @@ namespace detail {
 // infinite values that callers mask out. In place: vector arguments by value would trip GCC's
 // -Wpsabi note in the user's translation unit.
 template <class T>
-INFOLERP_SALIENCY_INLINE void exp_neg_inplace(T& x) {
+INFOLERP_FORCE_INLINE void exp_neg_inplace(T& x) {
   // Estrin's scheme: 4 dependent multiply-adds instead of Horner's 10 (the kernel is latency-bound).
   const T x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
   const T p01 = x * -0.24999999999999944 + 1.0, p23 = x * -0.0026041666665787633 + 0.03124999999998875;
@@ -394,19 +347,19 @@ using v4d = double __attribute__((vector_size(32)));
 // out = v where m, else +0 (bitwise, so an Inf outside the ball is harmless). Arguments by
 // reference: vector arguments by value would trip GCC's -Wpsabi note in the user's code.
 template <class V, class M>
-INFOLERP_SALIENCY_INLINE void keep(V& out, const M& m, const V& v) {
+INFOLERP_FORCE_INLINE void keep(V& out, const M& m, const V& v) {
   out = reinterpret_cast<V>(m & reinterpret_cast<M>(v));
 }
 // a = min(a, b) per lane (for finite values or +Inf).
 template <class V>
-INFOLERP_SALIENCY_INLINE void lane_min(V& a, const V& b) {
+INFOLERP_FORCE_INLINE void lane_min(V& a, const V& b) {
   const auto m = b < a;
   using M = decltype(m);
   a = reinterpret_cast<V>((m & reinterpret_cast<M>(b)) | (~m & reinterpret_cast<M>(a)));
 }
 // The smallest lane of v, by halving (log2(width) shuffles and minima, not width − 1 scalar ones).
 template <class V>
-INFOLERP_SALIENCY_INLINE double lanes_min(const V& lanes) {
+INFOLERP_FORCE_INLINE double lanes_min(const V& lanes) {
   constexpr std::size_t width = sizeof(V) / sizeof(double);
   V v = lanes;
   if constexpr (width == 8) {
@@ -435,12 +388,12 @@ inline double lanes_min(const lanes_fallback& v) {
 }
 
 template <class V>
-INFOLERP_SALIENCY_INLINE void load_lanes(V& v, const double* p) {
+INFOLERP_FORCE_INLINE void load_lanes(V& v, const double* p) {
   std::memcpy(&v, p, sizeof v);
 }
 
 template <class V>
-INFOLERP_SALIENCY_INLINE void store_lanes(double* p, const V& v) {
+INFOLERP_FORCE_INLINE void store_lanes(double* p, const V& v) {
   std::memcpy(p, &v, sizeof v);
 }
 
@@ -477,7 +430,7 @@ struct column_tile {
 // LC >= the number of σ: the σ loop is unrolled (8 at a time) so that, with LC = 8, i's sums
 // stay in registers (AVX-512: 16 of its 32).
 template <class V, std::size_t LC>
-INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
+INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                           column_tile tile, double* sums) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
   const std::size_t L = t.r2.size();
@@ -579,7 +532,7 @@ INFOLERP_SALIENCY_INLINE void gather_tile(const column_grid& g, const sigma_tabl
 
 // One tile with vectors V, 8 or 32 σ slots.
 template <class V>
-INFOLERP_SALIENCY_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
+INFOLERP_FORCE_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                               column_tile tile, double* sums) {
   if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, sums);
   gather_tile<V, 32>(g, t, span, tile, sums);
@@ -596,8 +549,7 @@ inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std
 
 // Define INFOLERP_NO_RUNTIME_DISPATCH to always use the portable kernel, INFOLERP_NO_AVX512 to
 // use AVX2 at most.
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(INFOLERP_NO_RUNTIME_DISPATCH)
-#define INFOLERP_SALIENCY_X86 1
+#ifdef INFOLERP_X86_DISPATCH
 using v8d = double __attribute__((vector_size(64)));
 __attribute__((target("avx2,fma"))) inline void gather_tile_avx2(const column_grid& g, const sigma_table& t,
                                                                  std::uint32_t span, column_tile tile, double* sums) {
@@ -607,13 +559,6 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
                                                                            std::uint32_t span, column_tile tile,
                                                                            double* sums) {
   gather_tile_any<v8d>(g, t, span, tile, sums);
-}
-// 2: AVX-512F, 1: AVX2 and FMA, 0: neither.
-inline int x86_vector_level() {
-#ifndef INFOLERP_NO_AVX512
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma")) return 2;
-#endif
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? 1 : 0;
 }
 #endif
 #if defined(__GNUC__) || defined(__clang__)
@@ -637,7 +582,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   const std::size_t stride = g.stride;
   std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
   double* sums = storage.data() + aligned_offset(storage);
-#ifdef INFOLERP_SALIENCY_X86
+#ifdef INFOLERP_X86_DISPATCH
   const int level = x86_vector_level();
 #endif
   // Tiles of span × span columns: a tile writes its own columns and those up to span later in x,
@@ -656,7 +601,7 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
     std::stable_sort(tiles.begin(), tiles.end(), [](const column_tile& a, const column_tile& b) { return a.points > b.points; });
     exec.parallel_for(tiles.size(), std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
-#ifdef INFOLERP_SALIENCY_X86
+#ifdef INFOLERP_X86_DISPATCH
         if (level == 2) {
           gather_tile_avx512(g, t, span, tiles[k], sums);
           continue;

@@ -258,10 +258,7 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
 // pool or the triangle count can seed; pool_multiplier < 1; normal_weight < 1 (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
-// reused by every round). Serial. bunny00 (75k faces), C = 10, 16 rounds: 0.37 s (CPU and wall,
-// BM_SalientClustering) on the 2-core Intel Xeon VM, 0.56 s wall when its core is shared
-// (~0.7 s on a loaded 2-core EPYC VM; 1.05 s there before the renumbering and the lighter queue
-// entries).
+// reused by every round). Serial.
 // Pure: concurrent calls on the same mesh are safe.
 template <class M>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,

@@ -8,9 +8,8 @@
 // textured colours (§5, Fig. 12), so a sample becomes a colour only after interpolation.
 // Beyond the paper: the default record's interpolation is perspective-correct when the engine
 // fills inv_depth (1 / view depth): the paper's screen-linear weights misplace texcoords on
-// surfaces seen at an angle, which was the largest error on the demo scene (measured there,
-// 1025², 518 feature ids cut at texture seams, 4 passes: 41.3 dB screen-linear, 45.7 dB
-// perspective-correct; benchmarks/results/upsample_1025.csv).
+// surfaces seen at an angle, which was the largest error on the demo scene (benchmarks/NOTES.md,
+// infolerp_pareto upsample).
 //
 // A sample source S models:
 //   typename S::sample_type                               the I-Buffer record (copyable)

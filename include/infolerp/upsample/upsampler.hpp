@@ -36,45 +36,8 @@
 // sample plus the extra evaluations; sources without agree() compile it out.
 //
 // Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// sun, 2 threads, process CPU time, least of 3 runs, one process, load average 3.3-3.6; full
-// per-pixel evaluation 3.33 s):
-//   plain, demo thresholds (518 ids):     4 passes 8.2x 45.7 dB, 5 passes 8.9x 44.0 dB
-//   plain, V0.54 O0.20 S0.10 (159 ids):   4 passes 11.1x 42.9 dB, 5 passes 12.5x 40.5 dB
-//   probes (primary + sun), 518 ids:      4 passes 11.7x 54.3 dB, 5 passes 13.3x 50.4 dB
-//   probes (primary + sun), 131 ids:      5 passes 14.1x 49.0 dB, 6 passes 14.4x 44.7 dB
-//   refined probes (primary, sun where needed), min_sources 1:
-//     518 ids: 2 passes 3.3x 61.2 dB, 3 passes 8.5x 56.8 dB, 4 passes 13.7x 53.9 dB, 5 passes 16.0x 49.7 dB
-//     159 ids: 4 passes 13.8x 53.1 dB, 5 passes 17.1x 48.8 dB, 6 passes 17.8x 45.0 dB
-//   joint-bilateral (primary + sun per pixel, AO + soft on a 1/k grid): 1/2 3.0x 59.5 dB,
-//     1/4 7.3x 56.0 dB, 1/8 11.8x 53.0 dB, 1/16 13.8x 48.4 dB; each is beaten by refined probes
-//     with a higher PSNR and 9%, 14%, 15%, 19% less CPU time (518 ids 2 and 3 passes, 159 ids 4
-//     and 5 passes). Before the per-row counters stopped sharing cache lines and the records
-//     stopped being copied whole (run_rows, sample_source.hpp), joint-bilateral was 3-6% faster
-//     at 1/4, 1/8 and 1/16 on the idle machine. Six idle runs since (wall, 2 threads; the last
-//     in upsample_1025_jb_idle.csv): the I-Buffer point with the next higher PSNR took
-//     -7.7 / -4.0 / -9.4 / -1.5 / -2.0 / +4.0% of joint-bilateral's time at 1/2, -14 / -8.9 /
-//     -10.4 / -3.6 / -9.1 / +2.5% at 1/4, -12 to -19% at 1/8 and -11 to -22% at 1/16: at the
-//     two finer grids both spend the same AO and soft-shadow work (25% and 6.3% of the pixels),
-//     and the margin (the sun rays the probes skip) is about the run-to-run noise.
-//   refined probes + agree() (AO and soft shadow within T, occlusion_within), against
-//     joint-bilateral in the same run, time of the cheapest point with higher PSNR and SSIM,
-//     three idle runs, wall (benchmarks/results/upsample_1025_tolerance.csv is the first; five
-//     loaded runs in CPU time agree): 1/2 grid (59.54 dB) beaten by 159 ids, min 2 sources, T 0.04, 4 passes (59.57 dB,
-//     8.8% evaluated) or 518 ids, same (59.85 dB, 9.1%) with 28.6-29.8% less time; 1/4 (56.05 dB)
-//     by 159 ids, min 2, T 0.16, 4 passes (56.18 dB, 3.5%) with 8.8-14.2% less; 1/8 and
-//     1/16 by rows without agree() (159 or 250 ids, min 1, 4 passes: 5.8-14.7% less; 143 or
-//     159 ids, 5 passes: 5.3-16.3%). Evaluations beyond the coarse grid sit
-//     near geometry, where occlusion and clusters change, and cost up to twice an average
-//     pixel's (--diagnose, plain I-Buffer, load ~1.6: 10.4 us per evaluation per thread at 3
-//     passes, 14.3 at 4, against 7.3 for the average pixel, sky included), so a tolerance buys
-//     little at 1/4 and nothing at 1/8 and 1/16; weighting the differences by the shading's
-//     ambient and area-light factors (tried) gained ~0.45 dB at equal evaluations but lost it
-//     again in agree()'s cost.
-// (SSIM ≥ 0.995 in all of these). The upsampler's own work (cheap source, one core,
-// BM_UpsampleInterpolatedPixel, load 1.1, median of 3) is 10.5–15.4 ns per interpolated pixel
-// (5 to 2 passes), 18.9 ns with probes, 14.5 ns with refined probes (the probes included) and
-// 15.7 ns with refined probes and agree() (occlusion_within).
-//
+// Time against error on the demo scene, beside joint-bilateral upsampling in the same run:
+// benchmarks/NOTES.md (infolerp_pareto upsample).
 // Determinism: each output row of a pass depends only on the previous pass, so rows run in
 // parallel through the user's executor and the output is identical for any executor and thread
 // count. Time is measured with `Clock` (std::chrono::steady_clock by default, or the user's) for
@@ -343,9 +306,7 @@ class upsampler {
 
   // Calls row_fn(j, counts) for every row j of buffer d through the executor and stores the
   // row's counts. They are counted in a local array: counting straight into row_counts_, whose
-  // neighbouring rows share a cache line but run on different threads, was false sharing that
-  // cost ~35 ms CPU of a 0.26 s probe frame when both threads ran at once (perf, demo scene
-  // 1025², 5 passes, 2 threads: probe_row's own time halved).
+  // neighbouring rows share a cache line but run on different threads, was false sharing.
   template <class E, class F>
   void run_rows(E& exec, std::uint32_t d, const F& row_fn) {
     const std::uint32_t rows = extents_[d][1];
