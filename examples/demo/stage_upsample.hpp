@@ -60,8 +60,13 @@ inline support::image error_heat_map(const support::image& img, const support::i
 inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* clusters = nullptr) {
   const auto& o = ctx.options;
   // The I-Buffer's ids: the clusters cut at texture seams (texcoords are interpolated within an id).
-  const support::scene_clustering ids =
+  const auto split =
       support::split_at_texture_seams(ctx.scene, clusters != nullptr ? *clusters : support::cluster_by_normal(ctx.scene, 2));
+  if (!split) {
+    report(split.error());
+    return false;
+  }
+  const support::scene_clustering& ids = *split;
   clusters = &ids;
   constexpr std::uint32_t tradeoff_first = 2, tradeoff_last = 5, auto_max_passes = 4, probe_first = 3, probe_min_sources = 1;
   const auto w = static_cast<std::uint32_t>(o.width), h = static_cast<std::uint32_t>(o.height);
