@@ -18,8 +18,9 @@
 //             (computed only when called: for the sky, for highlights)
 // Probes (sample_source.hpp, optional, a compile-time choice): probe_mode::primary probes trace
 // the primary ray and the hard-shadow rays; probe_mode::refine probes trace the primary ray only
-// and refine_probe adds the hard-shadow rays where the upsampler needs them. agree() is offered
-// when options.tolerance is finite (occlusion_within).
+// and refine_probe adds the hard-shadow rays where the upsampler needs them. agree() compares
+// the occlusion terms within options.tolerance (occlusion_within); the default, +infinity,
+// always agrees and gives the frame of a source without agree().
 // The AO directions are a fixed cosine-weighted Hammersley set rotated into each hit's tangent
 // frame, and the soft-shadow points a fixed set the engine gives, so evaluating a pixel twice
 // gives the same bits (no Monte Carlo noise for the upsampler to smear).
