@@ -745,7 +745,12 @@ int pareto_upsample(int argc, char** argv) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", clustered.error().message().c_str());
     return 1;
   }
-  const auto features = sup::split_at_texture_seams(*scene, *clustered);
+  const auto split = sup::split_at_texture_seams(*scene, *clustered);
+  if (!split) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", split.error().message().c_str());
+    return 1;
+  }
+  const sup::scene_clustering& features = *split;
   std::printf("feature clustering (demo thresholds): %zu clusters, %zu ids after the texture-seam split, %.1f s\n",
               clustered->count(), features.count(), now_seconds() - t0);
   // Coarser thresholds (fewer clusters): the paper's Fig. 8 setting (110 clusters there) and one between.
@@ -761,7 +766,12 @@ int pareto_upsample(int argc, char** argv) {
       std::fprintf(stderr, "infolerp_pareto upsample: %s\n", r.error().message().c_str());
       return 1;
     }
-    coarser.push_back(sup::split_at_texture_seams(*scene, *r));
+    auto coarse = sup::split_at_texture_seams(*scene, *r);
+    if (!coarse) {
+      std::fprintf(stderr, "infolerp_pareto upsample: %s\n", coarse.error().message().c_str());
+      return 1;
+    }
+    coarser.push_back(std::move(*coarse));
     char name[96];
     std::snprintf(name, sizeof name, "feature V%.2f O%.2f S%.2f", static_cast<double>(th.at("visibility")),
                   static_cast<double>(th.at("orientation")), static_cast<double>(th.at("stretch")));

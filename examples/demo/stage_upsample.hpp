@@ -60,8 +60,13 @@ inline support::image error_heat_map(const support::image& img, const support::i
 inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* clusters = nullptr) {
   const auto& o = ctx.options;
   // The I-Buffer's ids: the clusters cut at texture seams (texcoords are interpolated within an id).
-  const support::scene_clustering ids =
+  const auto split =
       support::split_at_texture_seams(ctx.scene, clusters != nullptr ? *clusters : support::cluster_by_normal(ctx.scene, 2));
+  if (!split) {
+    report(split.error());
+    return false;
+  }
+  const support::scene_clustering& ids = *split;
   clusters = &ids;
   constexpr std::uint32_t tradeoff_first = 2, tradeoff_last = 5, auto_max_passes = 4, probe_first = 3, probe_min_sources = 1;
   const auto w = static_cast<std::uint32_t>(o.width), h = static_cast<std::uint32_t>(o.height);
@@ -71,7 +76,14 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
     report(up.error());
     return false;
   }
-  const support::demo_ibuffer_source src{&ctx.shader, clusters, o.width, o.height};
+  // The library's ready source (upsample/ray_cast_source.hpp) with the reference shader's
+  // rays and shade() as its material.
+  auto ready = support::make_demo_ray_cast_source(ctx.shader, *clusters, o.width, o.height);
+  if (!ready) {
+    report(ready.error());
+    return false;
+  }
+  const auto& src = *ready;
 #ifdef _OPENMP
   const openmp_executor exec{o.threads};
 #else
@@ -104,17 +116,12 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
   // the sun ray only where the sources of the pixel's own cluster cannot vouch for its
   // hard-shadow bit, AO and soft shadow interpolated from those sources.
   {
-    support::shader_options po = ctx.shader.options();
-    po.ao_rays = 0;
-    po.soft_shadow_rays = 0;
-    const support::reference_shader primary_sun(ctx.scene, po);
-    po.hard_shadow = false;
-    const support::reference_shader primary(ctx.scene, po);
-    support::demo_refining_probe_source psrc;
-    static_cast<support::demo_ibuffer_source&>(psrc) = src;
-    psrc.primary = &primary;
-    psrc.probe_lights = false;
-    psrc.primary_sun = &primary_sun;
+    auto refining = support::make_demo_ray_cast_source<probe_mode::refine>(ctx.shader, *clusters, o.width, o.height);
+    if (!refining) {
+      report(refining.error());
+      return false;
+    }
+    const auto& psrc = *refining;
     auto pu = upsampler<support::demo_sample>::create(
         w, h, {.passes = probe_first, .max_passes = tradeoff_last, .record_kinds = false, .min_sources = probe_min_sources});
     if (!pu) {

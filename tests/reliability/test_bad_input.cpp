@@ -556,6 +556,22 @@ TEST_CASE("bad-input matrix: clustering options and channels", "[reliability][ba
                    frames, [&](std::size_t) -> const infolerp::support::brute_force_tracer& { return tracer; }, serial,
                    infolerp::cluster_options{}, infolerp::orientation_channel{})),
                {errc::non_finite, "vertex 3"});
+    indexed_mesh short_frame = base();
+    short_frame.keyframes = {short_frame.positions, short_frame.positions, short_frame.positions};
+    short_frame.keyframes[2].pop_back();  // keyframe 2 lacks the last vertex's position
+    check_cell("short keyframe", "cluster_keyframes",
+               status_of(infolerp::cluster_keyframes(
+                   short_frame, [&](std::size_t) -> const infolerp::support::brute_force_tracer& { return tracer; },
+                   serial, infolerp::cluster_options{}, infolerp::orientation_channel{})),
+               {errc::bad_size, "keyframe 2 has"});
+    indexed_mesh long_frame = base();
+    long_frame.keyframes = {long_frame.positions, long_frame.positions};
+    long_frame.keyframes[0].push_back(glm::vec3(0.0f));
+    check_cell("long keyframe", "cluster_keyframes",
+               status_of(infolerp::cluster_keyframes(
+                   long_frame, [&](std::size_t) -> const infolerp::support::brute_force_tracer& { return tracer; },
+                   serial, infolerp::cluster_options{}, infolerp::orientation_channel{})),
+               {errc::bad_size, "keyframe 0 has"});
   }
 }
 

@@ -8,7 +8,8 @@
 //       every object (positions welded first so that the clustering sees one surface; the
 //       triangles keep their order), ids offset per object; the I-Buffer then takes
 //   split_at_texture_seams(scene, clustering)
-//       the clusters cut along texture seams (texcoords are interpolated within an id).
+//       the clusters cut along texture seams (split_at_uv_seams per object; texcoords are
+//       interpolated within an id).
 // thresholds maps a channel name (visibility, orientation, stretch) to its Jensen-Shannon
 // threshold; missing ones take the demo's defaults (0.48, 0.05, 0.1). progress(label, done,
 // total) reports the visibility rays of each object; on_object(name, clustering) is called after
@@ -20,6 +21,7 @@
 #include <utility>
 #include <vector>
 #include "infolerp/cluster/cluster_mesh.hpp"
+#include "infolerp/cluster/uv_seams.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/procedural.hpp"
@@ -46,53 +48,18 @@ result<mesh_clustering> cluster_object(const indexed_mesh& mesh, const Tracer& t
                       stretch_channel{.threshold = th("stretch", 0.1), .bins = 256});
 }
 
-// Splits every cluster at texture seams: the I-Buffer interpolates texcoords, which is wrong
-// across a seam (u = 0.99 and u = 0.01 average to 0.5), and the paper's models use multi-chart
-// parameterisations. Ids become the connected pieces of (cluster ∩ texture chart): triangles
-// are connected through a shared vertex index at which both have the same texcoords (the demo's
-// meshes duplicate vertices along seams). Objects without texcoords keep their clusters, split
-// into connected pieces only. O(triangles) with union-find. A cluster that reaches around a
-// seam (connected the other way round, e.g. a whole UV sphere) stays one id: a limitation.
-// One mesh: ids[t] -> new ids 0..count-1 (returned in out), the count returned.
-inline std::uint32_t split_at_texture_seams(const indexed_mesh& m, const std::vector<std::uint32_t>& ids,
-                                            std::vector<std::uint32_t>& out) {
-  const std::size_t n = m.triangle_count();
-  std::vector<std::uint32_t> parent(n);
-  for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
-  const auto find = [&](std::uint32_t t) {
-    while (parent[t] != t) t = parent[t] = parent[parent[t]];
-    return t;
-  };
-  std::vector<std::vector<std::pair<std::uint32_t, glm::vec2>>> at_vertex(m.vertex_count());  // (triangle, uv)
-  for (std::size_t t = 0; t < n; ++t)
-    for (unsigned k = 0; k < 3; ++k)
-      at_vertex[m.triangles[t][static_cast<int>(k)]].push_back(
-          {static_cast<std::uint32_t>(t), m.has_texcoords() ? m.texcoord(t, k) : glm::vec2(0.0f)});
-  for (const auto& ts : at_vertex)
-    for (std::size_t i = 1; i < ts.size(); ++i)
-      for (std::size_t j = 0; j < i; ++j)
-        if (ids[ts[i].first] == ids[ts[j].first] && ts[i].second == ts[j].second)
-          parent[find(ts[i].first)] = find(ts[j].first);
-  out.assign(n, invalid_id);
-  std::vector<std::uint32_t> id_of_root(n, invalid_id);
-  std::uint32_t count = 0;
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::uint32_t r = find(static_cast<std::uint32_t>(t));
-    if (id_of_root[r] == invalid_id) id_of_root[r] = count++;
-    out[t] = id_of_root[r];
-  }
-  return count;
-}
-
-inline scene_clustering split_at_texture_seams(const demo_scene& scene, const scene_clustering& in) {
+// Splits every object's clusters at texture seams (split_at_uv_seams, cluster/uv_seams.hpp):
+// the I-Buffer interpolates texcoords within an id. Ids stay offset per object. Errors: those
+// of split_at_uv_seams, for the first object that has one.
+inline result<scene_clustering> split_at_texture_seams(const demo_scene& scene, const scene_clustering& in) {
   scene_clustering out{in.name, {}, {}};
   for (std::uint32_t g = 0; g < scene.objects.size(); ++g) {
-    std::vector<std::uint32_t> local;
-    const std::uint32_t count = split_at_texture_seams(scene.objects[g].mesh, in.ids[g], local);
+    auto r = split_at_uv_seams(scene.objects[g].mesh, in.ids[g]);
+    if (!r) return r.error();
     const auto offset = static_cast<std::uint32_t>(out.geometry_of.size());
-    for (auto& k : local) k += offset;
-    out.geometry_of.insert(out.geometry_of.end(), count, g);
-    out.ids.push_back(std::move(local));
+    for (auto& k : r->cluster_of) k += offset;
+    out.geometry_of.insert(out.geometry_of.end(), r->cluster_count, g);
+    out.ids.push_back(std::move(r->cluster_of));
   }
   return out;
 }

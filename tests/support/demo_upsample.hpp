@@ -17,10 +17,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <span>
 #include <string>
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/upsample/ray_cast_source.hpp"
 #include "infolerp/upsample/sample_source.hpp"
 #include "support/demo_scene.hpp"
 #include "support/image.hpp"
@@ -180,6 +183,67 @@ struct demo_tolerant_probe_source : demo_refining_probe_source {
   float tolerance = 0.05f;
   bool agree(const demo_sample& a, const demo_sample& b) const { return occlusion_within(a, b, tolerance); }
 };
+
+// The demo scene through the library's ready source (upsample/ray_cast_source.hpp): the same
+// rays and the same record as demo_ibuffer_source (its sun is light 0, its area light's points
+// the soft-shadow points), the reference shader's shade() as the material callback.
+struct demo_camera {
+  pinhole_rays rays;
+  int width = 0;
+  int height = 0;
+  ray operator()(float x, float y) const { return rays(x, y, width, height); }
+};
+struct demo_geometry {
+  const demo_scene* scene = nullptr;
+  const indexed_mesh& operator()(std::uint32_t g) const { return scene->objects[g].mesh; }
+};
+struct demo_material {
+  const reference_shader* shader = nullptr;
+  const scene_clustering* clusters = nullptr;
+  template <class View>
+  glm::vec3 operator()(const demo_sample& s, const View& view) const {
+    shading_inputs in;
+    if (s.background() || (s.lights & sun_light_bit) != 0) in.view = view();
+    if (s.background()) return shader->shade(in);
+    in.position = s.position;
+    in.normal = s.normal;
+    in.uv = s.texcoord;
+    in.geometry = clusters->geometry_of[s.cluster];
+    in.light_bits = s.lights;
+    in.ao = s.occlusion[0];
+    in.soft_shadow = s.occlusion[1];
+    return shader->shade(in);
+  }
+};
+template <probe_mode Probes = probe_mode::none>
+using demo_ray_cast_source = ray_cast_source<embree_scene, demo_camera, demo_geometry, demo_material, Probes>;
+
+// shader's options give the counts (AO rays, soft-shadow points, the sun when hard_shadow,
+// packets as batch_rays); clusters and shader must outlive the source.
+template <probe_mode Probes = probe_mode::none>
+result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_shader& shader, const scene_clustering& clusters,
+                                                               int width, int height, bool perspective = true,
+                                                               float tolerance = std::numeric_limits<float>::infinity()) {
+  const demo_scene& scene = shader.scene();
+  const shader_options& so = shader.options();
+  ray_cast_options o{.ao_rays = so.ao_rays, .ao_radius = scene.ao_radius, .ray_offset = scene.ray_offset};
+  if (so.hard_shadow) o.lights.push_back({.at = scene.sun.direction, .directional = true});
+  for (unsigned i = 0; i < so.soft_shadow_rays; ++i) {
+    const glm::vec2 h = hammersley(i, so.soft_shadow_rays);
+    o.soft_points.push_back(scene.area.point(h.x, h.y));
+  }
+  o.soft_normal = scene.area.normal();
+  o.batch_rays = so.packets;
+  if (perspective) {
+    o.view_origin = shader.camera_rays().eye;
+    o.view_forward = shader.camera_rays().forward;
+  }
+  o.tolerance = tolerance;
+  std::vector<std::span<const std::uint32_t>> ids(clusters.ids.begin(), clusters.ids.end());
+  return demo_ray_cast_source<Probes>::create(scene.tracer, demo_camera{shader.camera_rays(), width, height},
+                                              demo_geometry{&scene}, demo_material{&shader, &clusters}, std::move(ids),
+                                              std::move(o));
+}
 
 // Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.
 inline float display_luma(glm::vec3 linear) {

@@ -7,52 +7,22 @@
 #include <mutex>
 #include <glm/geometric.hpp>
 #include "infolerp/core/executor.hpp"
+#include "infolerp/upsample/ray_cast_source.hpp"
 
 namespace infolerp::support {
 
 namespace {
 constexpr float pi = 3.14159265358979323846f;
 
-// Van der Corput radical inverse in base 2: the second Hammersley coordinate.
-float radical_inverse(std::uint32_t i) {
-  i = (i << 16u) | (i >> 16u);
-  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-  return static_cast<float>(i) * 0x1p-32f;
-}
-
-// Point i of an n-point Hammersley set in [0,1)²: stratified in both coordinates.
-glm::vec2 hammersley(unsigned i, unsigned n) {
-  return {(static_cast<float>(i) + 0.5f) / static_cast<float>(n), radical_inverse(i)};
-}
-
-// A tangent frame around unit n that varies continuously with n everywhere except straight
-// down (n = -Z, where surfaces face away from this scene's cameras); Duff et al. 2017 with the
-// sign fixed to +1.
-void tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-  if (n.z < -0.9999f) {
-    t = {0.0f, -1.0f, 0.0f};
-    b = {-1.0f, 0.0f, 0.0f};
-    return;
-  }
-  const float a = 1.0f / (1.0f + n.z);
-  const float c = -n.x * n.y * a;
-  t = {1.0f - n.x * n.x * a, c, -n.x};
-  b = {c, 1.0f - n.y * n.y * a, -n.y};
-}
+// The fixed sample sets and the tangent frame are the ready sample source's
+// (upsample/ray_cast_source.hpp), so both trace the same rays.
+using infolerp::detail::tangent_frame;
 
 }  // namespace
 
 reference_shader::reference_shader(const demo_scene& scene, const shader_options& options)
     : scene_(&scene), options_(options), rays_(scene.view.rays()) {
-  // Cosine-weighted hemisphere directions (Malley's method on Hammersley points).
-  for (unsigned i = 0; i < options_.ao_rays; ++i) {
-    const glm::vec2 s = hammersley(i, options_.ao_rays);
-    const float r = std::sqrt(s.x), phi = 2.0f * pi * s.y;
-    hemisphere_.push_back({r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - s.x))});
-  }
+  hemisphere_ = cosine_hemisphere(options_.ao_rays);  // cosine-weighted, Malley's method on Hammersley points
   for (unsigned i = 0; i < options_.soft_shadow_rays; ++i) {
     const glm::vec2 s = hammersley(i, options_.soft_shadow_rays);
     light_points_.push_back(scene.area.point(s.x, s.y));

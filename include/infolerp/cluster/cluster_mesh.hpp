@@ -234,7 +234,9 @@ struct keyframe_view {
 // §3.4: Algorithm 1 for keyframe 0, then for each later keyframe starting from the previous
 // keyframe's clusters (so clusters only ever split and stay consistent over the animation).
 // tracer_of(k) returns the tracer of keyframe k's geometry (called once per keyframe).
-// Errors: as cluster_mesh, a mesh without keyframes (empty_input), non-finite keyframe positions.
+// Errors: as cluster_mesh, a mesh without keyframes (empty_input), a keyframe whose position
+// count differs from the vertex count (bad_size, naming the keyframe; checked before any
+// position is read, where the mesh type offers keyframe_vertex_count), non-finite positions.
 // Complexity: keyframe_count × cluster_mesh.
 template <class M, class F, class E, class... C>
 result<mesh_clustering> cluster_keyframes(const M& m, F&& tracer_of, E&& exec, const cluster_options& opts,
@@ -244,6 +246,10 @@ result<mesh_clustering> cluster_keyframes(const M& m, F&& tracer_of, E&& exec, c
   static_assert(check_executor<std::remove_cvref_t<E>>());
   const std::size_t nk = mesh_keyframe_count(m);
   if (nk == 0) return make_error(errc::empty_input, no_element, "cluster_keyframes: mesh has no keyframes");
+  for (std::size_t k = 0; k < nk; ++k)
+    if (const std::size_t n = mesh_keyframe_vertex_count(m, k); n != mesh_vertex_count(m))
+      return make_error(errc::bad_size, k, "cluster_keyframes: keyframe ", k, " has ", n, " positions for ",
+                        mesh_vertex_count(m), " vertices");
   auto topo = build_topology(m);
   if (!topo) return topo.error();
   mesh_clustering out;

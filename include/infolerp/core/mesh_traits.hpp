@@ -7,7 +7,10 @@
 // Optional capabilities, detected at compile time and checked at run time:
 //   texcoords:  texcoord(t, corner) -> glm::vec2, has_texcoords() -> bool (true if absent)
 //   normals:    normal(v) -> glm::vec3,           has_normals() -> bool (true if absent)
-//   keyframes:  keyframe_count() -> size_t, keyframe_position(k, v) -> glm::vec3
+//   keyframes:  keyframe_count() -> size_t, keyframe_position(k, v) -> glm::vec3, and
+//               keyframe_vertex_count(k) -> size_t (positions stored for keyframe k): with it,
+//               entry points report a short keyframe; without it, every keyframe must hold a
+//               position per vertex (unchecked)
 // The library never stores a reference to the mesh beyond the call that received it.
 #include <concepts>
 #include <cstddef>
@@ -46,6 +49,8 @@ struct mesh_traits {
   { return static_cast<std::size_t>(m.keyframe_count()); }
   static glm::vec3 keyframe_position(const M& m, std::size_t k, std::size_t v) requires requires { { m.keyframe_position(k, v) } -> std::convertible_to<glm::vec3>; }
   { return m.keyframe_position(k, v); }
+  static std::size_t keyframe_vertex_count(const M& m, std::size_t k) requires requires { { m.keyframe_vertex_count(k) } -> std::convertible_to<std::size_t>; }
+  { return static_cast<std::size_t>(m.keyframe_vertex_count(k)); }
 };
 
 namespace detail {
@@ -108,6 +113,12 @@ template <mesh M> bool mesh_has_normals(const M& m) {
 template <mesh M> std::size_t mesh_keyframe_count(const M& m) {
   if constexpr (keyframed_mesh<M>) return mesh_traits<M>::keyframe_count(m);
   else return 0;
+}
+// Positions stored for keyframe k: keyframe_vertex_count(k) where the type offers it, else
+// vertex_count() (the documented precondition of keyframes without it).
+template <mesh M> std::size_t mesh_keyframe_vertex_count(const M& m, std::size_t k) {
+  if constexpr (requires { mesh_traits<M>::keyframe_vertex_count(m, k); }) return mesh_traits<M>::keyframe_vertex_count(m, k);
+  else return mesh_vertex_count(m);
 }
 
 }  // namespace infolerp

@@ -57,6 +57,7 @@ struct indexed_mesh {
   glm::vec3 normal(std::size_t v) const { return normals[v]; }
   std::size_t keyframe_count() const { return keyframes.size(); }
   glm::vec3 keyframe_position(std::size_t k, std::size_t v) const { return keyframes[k][v]; }
+  std::size_t keyframe_vertex_count(std::size_t k) const { return keyframes[k].size(); }
 
   mesh_view view() const { return {positions, triangles, texcoords, normals}; }
 };

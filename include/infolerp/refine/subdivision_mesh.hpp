@@ -256,6 +256,7 @@ class subdivision_mesh {
       }
     }
     s.original_count_ = nt;
+    s.original_vertex_count_ = nv;
     s.leaf_count_ = nt;
     return s;
   }
@@ -376,6 +377,71 @@ class subdivision_mesh {
     return out;
   }
 
+  // The leaves as a mesh that carries the input mesh's attributes, so that a mesh tessellated
+  // for a view (§4.1) clusters, traces and upsamples like any other. `source` is the mesh
+  // build() read. Each leaf's corners get the barycentric weights of their positions in the
+  // leaf's original triangle (subdivision is flat, so the weights are exact up to rounding);
+  // per-corner texcoords are interpolated with them within that triangle (UV seams stay
+  // seams), and every new vertex's normal (renormalised) and keyframe positions within the
+  // triangle it was created in. leaf_source[i] = the original triangle of leaf i, so per-
+  // triangle data (cluster ids) carries over as leaf_source[i] -> data[leaf_source[i]].
+  // Errors: source's vertex or triangle count differs from build()'s (bad_size); a keyframe
+  // without a position per vertex (bad_size, naming it).
+  // Complexity O(V + triangle_count() + V·keyframes); allocates the mesh and leaf_source.
+  template <class M>
+  [[nodiscard]] result<indexed_mesh> leaf_mesh(const M& source, std::vector<std::uint32_t>& leaf_source) const {
+    static_assert(check_mesh<M>());
+    if (mesh_vertex_count(source) != original_vertex_count_ || mesh_triangle_count(source) != original_count_)
+      return make_error(errc::bad_size, no_element, "leaf_mesh: source has ", mesh_vertex_count(source), " vertices and ",
+                        mesh_triangle_count(source), " triangles; the hierarchy was built from ", original_vertex_count_,
+                        " and ", original_count_);
+    const std::size_t nk = mesh_keyframe_count(source);
+    for (std::size_t k = 0; k < nk; ++k)
+      if (const std::size_t n = mesh_keyframe_vertex_count(source, k); n != original_vertex_count_)
+        return make_error(errc::bad_size, k, "leaf_mesh: keyframe ", k, " has ", n, " positions for ",
+                          original_vertex_count_, " vertices");
+    indexed_mesh out = leaf_mesh();
+    leaf_source.clear();
+    leaf_source.reserve(leaf_count_);
+    for (const subdivision_triangle& n : tris_)
+      if (n.is_leaf()) leaf_source.push_back(n.original);
+    if constexpr (textured_mesh<M>) {
+      if (mesh_has_texcoords(source)) {
+        out.texcoords.resize(3 * out.triangles.size());
+        for (std::size_t i = 0; i < out.triangles.size(); ++i)
+          for (unsigned c = 0; c < 3; ++c) {
+            const glm::dvec3 w = weights_in(leaf_source[i], out.triangles[i][static_cast<int>(c)]);
+            glm::dvec2 uv(0.0);
+            for (unsigned k = 0; k < 3; ++k) uv += w[static_cast<int>(k)] * glm::dvec2(mesh_traits<M>::texcoord(source, leaf_source[i], k));
+            out.texcoords[3 * i + c] = glm::vec2(uv);
+          }
+      }
+    }
+    const auto per_vertex = [&](auto&& value, std::vector<glm::vec3>& into, bool unit) {
+      into.resize(positions_.size());
+      for (std::size_t v = 0; v < positions_.size(); ++v) {
+        if (v < original_vertex_count_) {
+          into[v] = value(v);
+          continue;
+        }
+        const std::uint32_t t = vertex_source_[v];
+        const glm::uvec3 tri = tris_[t].vertices;
+        const glm::dvec3 w = weights_in(t, static_cast<std::uint32_t>(v));
+        const glm::dvec3 x = w.x * glm::dvec3(value(tri.x)) + w.y * glm::dvec3(value(tri.y)) + w.z * glm::dvec3(value(tri.z));
+        const double len = glm::length(x);
+        into[v] = glm::vec3(unit && len > 0.0 ? x / len : x);
+      }
+    };
+    if constexpr (mesh_with_normals<M>) {
+      if (mesh_has_normals(source))
+        per_vertex([&](std::size_t v) { return glm::vec3(mesh_traits<M>::normal(source, v)); }, out.normals, true);
+    }
+    out.keyframes.resize(nk);
+    for (std::size_t k = 0; k < nk; ++k)
+      per_vertex([&](std::size_t v) { return glm::vec3(mesh_traits<M>::keyframe_position(source, k, v)); }, out.keyframes[k], false);
+    return out;
+  }
+
   // Clustering paper §4.1: splits (closure only, no propagation) every leaf for which
   // needs_split(p0, p1, p2) holds, repeatedly, until none does or the leaf reached max_level.
   // Use screen_fraction_test for the paper's criterion. Returns the number of selections.
@@ -406,6 +472,18 @@ class subdivision_mesh {
 
  private:
   static constexpr std::uint32_t closure_only = std::numeric_limits<std::uint32_t>::max() / 2;
+
+  // Barycentric weights of vertex v's position in original triangle t (least squares in the
+  // triangle's plane; v lies in it). O(1).
+  [[nodiscard]] glm::dvec3 weights_in(std::uint32_t t, std::uint32_t v) const {
+    const glm::uvec3 tri = tris_[t].vertices;
+    const glm::dvec3 a(positions_[tri.x]), e1 = glm::dvec3(positions_[tri.y]) - a, e2 = glm::dvec3(positions_[tri.z]) - a;
+    const glm::dvec3 d = glm::dvec3(positions_[v]) - a;
+    const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    const double p1 = glm::dot(d, e1), p2 = glm::dot(d, e2), det = d11 * d22 - d12 * d12;
+    const double u = (d22 * p1 - d12 * p2) / det, w = (d11 * p2 - d12 * p1) / det;
+    return {1.0 - u - w, u, w};
+  }
   struct pending {
     std::uint32_t triangle, depth;
   };
@@ -557,6 +635,7 @@ class subdivision_mesh {
   subdivision_options options_;
   std::vector<glm::vec3> positions_;
   std::vector<std::uint32_t> vertex_source_;
+  std::size_t original_vertex_count_ = 0;
   std::vector<subdivision_triangle> tris_;
   detail::edge_table edges_;
   std::vector<pending> queue_;
