@@ -11,6 +11,7 @@
 #include "infolerp/refine/progressive_driver.hpp"        // progressive refinement (NLD_OS, NLD_IS, RND)
 #include "infolerp/upsample/upsampler.hpp"               // the I-Buffer upsampler
 #include "infolerp/upsample/pass_controller.hpp"         // automatic pass count
+#include "infolerp/cluster/uv_seams.hpp"               // clusters cut at texture seams
 #include "infolerp/mesh/validate.hpp"                    // mesh checks
 #include "infolerp/mesh/locality_order.hpp"              // Morton order of triangles
 
@@ -19,6 +20,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/upsample/sample_source.hpp"
+#include "infolerp/upsample/ray_cast_source.hpp"          // a ready sample source over your tracer
 #include "infolerp/mesh/adaptors.hpp"                    // ready mesh types and views
 
 // Building blocks: channels, one-channel clustering, information theory, geometry, refinement.
