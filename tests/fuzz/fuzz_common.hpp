@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the libFuzzer targets (issue 8): a byte reader that consumes the input from the
+// Shared by the libFuzzer targets: a byte reader that consumes the input from the
 // front (so seed files are easy to write by hand), a check macro that aborts (libFuzzer then
 // saves the input), and a small-mesh decoder that can produce every kind of bad mesh.
 #include <algorithm>

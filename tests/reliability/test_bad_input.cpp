@@ -1,4 +1,4 @@
-// The bad-input matrix (issue 8): classes of bad input against every public entry point that
+// The bad-input matrix: classes of bad input against every public entry point that
 // takes user data. Each cell says what must happen: a status with a given code whose message
 // names the problem (a substring), or success with finite, well-formed output. Nothing may
 // crash (CI runs this under ASan + UBSan) and nothing may be half-written: where an entry point

@@ -1,4 +1,4 @@
-// Determinism (issue 8): every component gives bit-identical output across repeated runs
+// Determinism: every component gives bit-identical output across repeated runs
 // and for the serial executor and thread_pool_executor with 1, 2 and 8 workers (small grains,
 // so that the work really is split). Components without an executor parameter (topology,
 // salient clustering, subdivision, Jensen–Shannon) are checked across repeated runs and with

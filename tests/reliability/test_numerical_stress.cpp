@@ -1,4 +1,4 @@
-// Numerical stress (issue 8): coordinates scaled by 1e±30, float against double inputs,
+// Numerical stress: coordinates scaled by 1e±30, float against double inputs,
 // slivers with angles near 0 and 180 degrees, distributions of a million bins, thresholds at
 // exactly 0 and 1. Results must be finite and within the tolerances stated next to each check
 // (derived from float rounding, 2^-24 ≈ 6e-8 relative, and the figures the headers document).
