@@ -16,26 +16,8 @@
 #include <glm/geometric.hpp>
 #include <glm/vec4.hpp>
 #include "infolerp/upsample/upsampler.hpp"
+#include "support/allocation_counter.hpp"
 #include "support/thread_pool.hpp"
-
-// Counts heap allocations, to show that rendering allocates nothing.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-// The nothrow form too: Catch2 allocates with it, and under ASan the runtime's own nothrow
-// new would otherwise pair with the free() below (alloc-dealloc-mismatch).
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(n == 0 ? 1 : n);
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -415,12 +397,12 @@ TEST_CASE("rendering allocates nothing once the upsampler exists", "[upsample]")
   auto up = make(200, 150, 4);
   std::vector<glm::vec4> out(200 * 150);
   REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
-  const std::size_t before = g_allocations.load();
+  const std::size_t before = infolerp::support::heap_allocations.load();
   for (std::uint32_t passes : {4u, 2u, 5u, 1u}) {
     REQUIRE(up.set_passes(passes).ok());
     REQUIRE(up.render(src, std::span<glm::vec4>(out)).ok());
   }
-  CHECK(g_allocations.load() == before);
+  CHECK(infolerp::support::heap_allocations.load() == before);
 }
 
 TEST_CASE("serial and parallel outputs are bit-identical", "[upsample]") {
@@ -575,9 +557,9 @@ void check_probe_frames_bit_identical(const Src& src, F&& after_serial) {
       CHECK(std::memcmp(out.data(), ref.data(), out.size() * sizeof(glm::vec4)) == 0);
       CHECK(std::equal(up.kinds().begin(), up.kinds().end(), serial.kinds().begin()));
     }
-    const std::size_t before = g_allocations.load();
+    const std::size_t before = infolerp::support::heap_allocations.load();
     REQUIRE(serial.render(src, std::span<glm::vec4>(ref)).ok());
-    CHECK(g_allocations.load() == before);
+    CHECK(infolerp::support::heap_allocations.load() == before);
   }
 }
 
