@@ -3,6 +3,7 @@
 // shading, each criterion's termination rule checked from outside, determinism across executors.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -203,12 +204,56 @@ TEST_CASE("driver: identical results for any executor") {
   CHECK(image_of(a, cam) == image_of(b, cam));
 }
 
+TEST_CASE("driver: NLD_OS with a random pass finds a shadow that no vertex shows; plain NLD_OS cannot") {
+  // 8×8 cells of 2×2/8 units: every triangle is far below always_refine_fraction of the image, and
+  // a small shadow square lies between the vertices, so stage 1 shows no luminance difference.
+  const auto m = support::make_plane(8, 8, 2.0f);
+  const auto cam = top_camera();
+  glm::vec3 (*square)(glm::vec3) = [](glm::vec3 p) {
+    return std::abs(p.x - 0.37f) < 0.07f && std::abs(p.y + 0.37f) < 0.07f ? glm::vec3(0.05f) : glm::vec3(0.9f);
+  };
+  const auto ref = reference(m, cam, square);
+  auto shade = [&](const shading_point& sp) { return square(sp.position); };
+  const criteria_options plain{.criterion = refinement_criterion::nld_os, .s_req = 0.05f, .batch = 16};
+  criteria_options mixed = plain;
+  mixed.random_share = 0.25f;
+  mixed.rnd_point_fraction = 0.3f;
+  auto a = make_refiner(m, {.criteria = plain}), b = make_refiner(m, {.criteria = mixed}), c = make_refiner(m, {.criteria = mixed});
+  auto ra = a.run(brute_force_tracer{&m}, cam, shade, serial_executor{});
+  auto rb = b.run(brute_force_tracer{&m}, cam, shade, serial_executor{});
+  auto rc = c.run(brute_force_tracer{&m}, cam, shade, support::thread_pool_executor{3});
+  REQUIRE(ra.ok());
+  REQUIRE(rb.ok());
+  REQUIRE(rc.ok());
+  CHECK(ra->batches == 0);  // plain NLD_OS finds nothing to refine
+  CHECK(ra->stage2.shading_samples == ra->stage1.shading_samples);
+  CHECK(rb->batches > 0);
+  CHECK_FALSE(rb->budget_reached);  // ended by the rule: NLD_OS and the random budget exhausted
+  const double pa = psnr(image_of(a, cam), ref), pb = psnr(image_of(b, cam), ref);
+  INFO("plain " << pa << " dB, with a random pass " << pb << " dB, " << rb->stage2.shading_samples << " samples");
+  CHECK(pb > pa + 3.0);
+  // Deterministic for any executor.
+  CHECK(rb->stage2.shading_samples == rc->stage2.shading_samples);
+  CHECK(image_of(b, cam) == image_of(c, cam));
+  // A batch never names a leaf twice, though NLD_OS and the random draws meet the same leaves.
+  criteria_options wide = mixed;
+  wide.s_req = 0.0f, wide.min_pixels = 0.0f, wide.batch = 64, wide.random_share = 0.5f;
+  criterion_state st;
+  std::vector<std::uint32_t> picked;
+  CHECK(select_for_refinement(b.frame(), wide, st, picked) == 64);
+  std::sort(picked.begin(), picked.end());
+  CHECK(std::adjacent_find(picked.begin(), picked.end()) == picked.end());
+}
+
 TEST_CASE("driver: errors") {
   const auto m = floor_mesh();
   auto s = subdivision_mesh::build(m);
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(*s, {.criteria = {.s_req = 2.0f}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.batch = 0}}).error().code() == errc::bad_parameter);
+  CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = 1.5f}}).error().code() == errc::bad_parameter);
+  CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = std::numeric_limits<float>::quiet_NaN()}})
+            .error().code() == errc::bad_parameter);
   auto r = make_refiner(m, {});
   auto shade = [](const shading_point&) { return glm::vec3(1.0f); };
   CHECK(r.start(brute_force_tracer{&m}, top_camera(0, 0), shade, serial_executor{}).code() == errc::empty_input);

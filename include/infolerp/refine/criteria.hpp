@@ -18,6 +18,10 @@
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
+//  - NLD_OS with a random pass (§7, future work: "merge NLD_OS with a random pass", to find
+//    discontinuities that no vertex luminance shows yet): with `random_share` s > 0, NLD_OS takes
+//    up to R − round(s·R) triangles and RND's rule fills the batch up to R with triangles not
+//    already chosen, under RND's point budget; the criterion ends when both find nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -52,6 +56,7 @@ struct criteria_options {
   std::uint32_t batch = 64;              // R: triangles selected per batch
   float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count
   float nld_is_pixel_fraction = std::numeric_limits<float>::infinity();  // NLD_IS: stop once the view's requests reach this fraction of the pixels
+  float random_share = 0.0f;             // NLD_OS: share of each batch given to a random pass (0: none)
   std::uint64_t seed = 1;                // RND: random sequence
 };
 
@@ -68,6 +73,8 @@ inline status validate(const criteria_options& o) {
     return make_error(errc::bad_parameter, no_element, "criteria_options.nld_is_pixel_fraction must be >= 0");
   if (!(o.rnd_point_fraction >= 0.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.rnd_point_fraction must be >= 0");
+  if (!(o.random_share >= 0.0f && o.random_share <= 1.0f))
+    return make_error(errc::bad_parameter, no_element, "criteria_options.random_share ", o.random_share, " outside [0, 1]");
   return {};
 }
 
@@ -100,9 +107,10 @@ inline float leaf_nld(const refinement_frame& f, std::uint32_t t) {
 }  // namespace detail
 
 // NLD_OS (§4, §4.1): visible leaves with S > S_req and at least min_pixels pixels, plus leaves
-// covering more than always_refine_fraction of the image. Appends up to R ids to `out`.
+// covering more than always_refine_fraction of the image. Appends up to `limit` ids to `out`.
 // Complexity O(visible · log R); allocation O(candidates).
-inline void select_nld_os(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
+inline void select_nld_os(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out,
+                          std::size_t limit) {
   struct candidate {
     bool forced;
     float key;
@@ -124,7 +132,7 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
     if (a.key != b.key) return a.key > b.key;
     return a.id < b.id;
   };
-  const std::size_t n = std::min<std::size_t>(o.batch, c.size());
+  const std::size_t n = std::min(limit, c.size());
   std::partial_sort(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(n), c.end(), before);
   for (std::size_t i = 0; i < n; ++i) out.push_back(c[i].id);
 }
@@ -171,16 +179,17 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
   }
 }
 
-// RND (§4): uniformly drawn pixels select the qualifying leaf under them. Appends up to R ids.
-// Complexity O(points drawn); allocation O(R).
+// RND (§4): uniformly drawn pixels select the qualifying leaf under them, skipping leaves
+// already in out[first, end). Appends up to `count` ids. Complexity O(points drawn · count);
+// allocation O(count).
 inline void select_rnd(const refinement_frame& f, const criteria_options& o, criterion_state& st,
-                       std::vector<std::uint32_t>& out) {
+                       std::vector<std::uint32_t>& out, std::size_t first, std::size_t count) {
   const std::uint64_t pixels = std::uint64_t(f.width) * f.height;
   const auto cap = static_cast<std::uint64_t>(double(o.rnd_point_fraction) * double(pixels));
-  const std::size_t first = out.size();
-  // At most 8·R draws per batch, so one batch cannot burn the whole point budget on the same
-  // few triangles; a batch whose 8·R draws all miss ends the criterion's work (returns nothing).
-  for (std::uint64_t draws = 0; out.size() - first < o.batch && draws < 8ull * o.batch; ++draws) {
+  const std::size_t goal = out.size() + count;
+  // At most 8·count draws per batch, so one batch cannot burn the whole point budget on the
+  // same few triangles; a batch whose draws all miss ends the random work (returns nothing).
+  for (std::uint64_t draws = 0; out.size() < goal && draws < 8ull * count; ++draws) {
     if (st.points_drawn >= cap || pixels == 0) {
       st.exhausted = true;
       return;
@@ -200,9 +209,14 @@ inline std::size_t select_for_refinement(const refinement_frame& f, const criter
                                          std::vector<std::uint32_t>& out) {
   const std::size_t before = out.size();
   switch (o.criterion) {
-    case refinement_criterion::nld_os: select_nld_os(f, o, out); break;
+    case refinement_criterion::nld_os: {
+      const auto random = static_cast<std::size_t>(std::lround(double(o.random_share) * double(o.batch)));
+      select_nld_os(f, o, out, o.batch - random);
+      if (random > 0 && !st.exhausted) select_rnd(f, o, st, out, before, o.batch - (out.size() - before));
+      break;
+    }
     case refinement_criterion::nld_is: select_nld_is(f, o, out); break;
-    case refinement_criterion::rnd: select_rnd(f, o, st, out); break;
+    case refinement_criterion::rnd: select_rnd(f, o, st, out, before, o.batch); break;
   }
   return out.size() - before;
 }
