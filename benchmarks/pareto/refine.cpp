@@ -58,7 +58,7 @@ struct run_result {
 template <class E>
 run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::vector<glm::vec3>& reference,
                infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec,
-               float rnd_fraction = 1.0f) {
+               float rnd_fraction = 1.0f, float random_share = 0.0f) {
   auto sub = infolerp::subdivision_mesh::build(sc.mesh);
   if (!sub.ok()) {
     std::fprintf(stderr, "%s\n", sub.error().message().c_str());
@@ -70,6 +70,7 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   o.criteria.batch = 64;
   o.criteria.always_refine_fraction = 0.02f;
   o.criteria.rnd_point_fraction = rnd_fraction;
+  o.criteria.random_share = random_share;
   o.max_shading_samples = budget;
   auto r = infolerp::progressive_refiner::create(std::move(*sub), o);
   const auto shade = [&](const infolerp::shading_point& sp) { return sc.shade(sp.position, sp.triangle); };
@@ -251,6 +252,20 @@ int pareto_refine(int argc, char** argv) {
       std::printf("%10.2f %12zu %10.2f %14zu %7.1f%%\n", double(fraction), rs, rr.psnr2, reach->first,
                   100.0 * double(reach->first) / double(rs));
   }
+
+  // NLD_OS with a random pass (§7): part of each batch drawn as RND draws it, under RND's point
+  // budget. Final samples and PSNR beside plain NLD_OS's and RND's.
+  std::printf("NLD_OS with a random pass (share of each batch, RND point fraction): final samples and PSNR\n");
+  std::printf("%8s %10s %12s %10s %16s\n", "share", "fraction", "samples", "dB", "dB - NLD_OS");
+  std::printf("%8s %10s %12zu %10.2f %16s\n", "0", "-", os_final, os_psnr, "0");
+  for (float share : {0.125f, 0.25f, 0.5f})
+    for (float fraction : {0.1f, 0.3f}) {
+      const run_result rr =
+          run(sc, cam, reference, infolerp::refinement_criterion::nld_os, unlimited, s_req, exec, fraction, share);
+      std::printf("%8.3f %10.2f %12zu %10.2f %+16.2f\n", double(share), double(fraction),
+                  rr.report.stage2.shading_samples, rr.psnr2, rr.psnr2 - os_psnr);
+    }
+  std::printf("%8s %10s %12zu %10.2f %+16.2f  (RND alone)\n", "1", "1.00", rnd_samples, rnd_psnr, rnd_psnr - os_psnr);
 
   // Plot: PSNR against shading samples, one line per criterion.
   const std::string gp = stem + ".gp";
