@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/mesh/curvature.hpp"
@@ -197,6 +199,21 @@ TEST_CASE("saliency: bad input gets a clear status") {
   CHECK(bad_scale.error().message().find("scale 1") != std::string::npos);
   auto no_scale = infolerp::compute_saliency(m, {.scales = {}});
   CHECK(no_scale.error().code() == infolerp::errc::bad_parameter);
+  // 17 scales as given, though only 2 distinct values (4 distinct sigma).
+  const std::vector<double> seventeen = {2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0, 3.0, 2.0};
+  auto too_many = infolerp::compute_saliency(m, {.scales = seventeen});
+  REQUIRE(!too_many.ok());
+  CHECK(too_many.error().code() == infolerp::errc::bad_parameter);
+  CHECK(too_many.error().message().find("17 scales") != std::string::npos);
+  CHECK(infolerp::compute_saliency(m, {.scales = std::vector<double>(seventeen.begin(), seventeen.end() - 1)}).ok());
+  for (double threshold : {std::nan(""), -1e-3, std::numeric_limits<double>::infinity()}) {
+    INFO("flat_level_threshold " << threshold);
+    auto bad_threshold = infolerp::compute_saliency(m, {.flat_level_threshold = threshold});
+    REQUIRE(!bad_threshold.ok());
+    CHECK(bad_threshold.error().code() == infolerp::errc::bad_parameter);
+    CHECK(bad_threshold.error().message().find("flat_level_threshold") != std::string::npos);
+  }
+  CHECK(infolerp::compute_saliency(m, {.flat_level_threshold = 0.0}).ok());
   auto bad_idx = m;
   bad_idx.triangles[5].z = 1000;
   auto r = infolerp::compute_saliency(bad_idx);

@@ -715,7 +715,8 @@ std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, 
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales, a scale <= 0 or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ
+// scales or more than 16 (counted as given, repeats included), a scale <= 0 or not finite,
+// flat_level_threshold negative or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ
 // (scale × epsilon × diagonal) below ~1.5e-154 or above ~3.3e153, where σ² underflows or 16σ²
 // overflows (bad_parameter); a
 // mesh whose bounding box has zero diagonal (degenerate_triangle).
@@ -731,6 +732,12 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   if (!(opt.epsilon > 0.0) || !std::isfinite(opt.epsilon))
     return make_error(errc::bad_parameter, no_element, "saliency epsilon ", opt.epsilon, " must be positive and finite");
   if (opt.scales.empty()) return make_error(errc::bad_parameter, no_element, "saliency needs at least one scale");
+  if (opt.scales.size() > 16)
+    return make_error(errc::bad_parameter, no_element, "saliency got ", opt.scales.size(),
+                      " scales; at most 16 are supported");
+  if (!(opt.flat_level_threshold >= 0.0) || !std::isfinite(opt.flat_level_threshold))
+    return make_error(errc::bad_parameter, no_element, "saliency flat_level_threshold ", opt.flat_level_threshold,
+                      " must be finite and >= 0");
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
@@ -756,7 +763,6 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (double s : opt.scales) mult.push_back(s), mult.push_back(2.0 * s);
   std::sort(mult.begin(), mult.end());
   mult.erase(std::unique(mult.begin(), mult.end()), mult.end());
-  if (mult.size() > 32) return make_error(errc::bad_parameter, no_element, "at most 16 saliency scales are supported");
   std::vector<double> sigma(mult.size());
   for (std::size_t u = 0; u < mult.size(); ++u) {
     sigma[u] = mult[u] * out.epsilon;
