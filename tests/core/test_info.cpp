@@ -154,6 +154,34 @@ TEST_CASE("JS adversarial: subnormals, p == q up to the last bit, float32, a mil
   }
 }
 
+TEST_CASE("JS accuracy does not decay with the bin count: one-hot against uniform, weights 0.9/0.1") {
+  // Closed form in long double: bin 0 has p = 1, q = 1/n; the other n - 1 bins p = 0, q = 1/n.
+  const auto closed_form = [](std::size_t n, long double wp, long double wq) {
+    const long double u = 1.0L / static_cast<long double>(n), m0 = wp + wq * u;
+    return wp * std::log2(1.0L / m0) + wq * u * std::log2(u / m0) +
+           static_cast<long double>(n - 1) * wq * u * std::log2(1.0L / wq);
+  };
+  // Every bin's term is >= 0 and JS is 0.47 here: about 18 roundings of it bound the summation.
+  constexpr double tolerance = 1e-15;
+  for (std::size_t n : {std::size_t{4096}, std::size_t{1} << 16, std::size_t{1} << 20}) {
+    CAPTURE(n);
+    std::vector<double> p(n, 0.0), q(n, 1.0 / static_cast<double>(n)), p3(n, 0.0), q_tenths(n, 0.1);
+    p[0] = 1.0;
+    p3[0] = 3.0;
+    // The two-way kernel weighs q by 1 - 0.9 in double (exact, Sterbenz); the n-ary form by 0.1.
+    const long double two_way = closed_form(n, 0.9L, 1.0L - 0.9L), n_ary = closed_form(n, 0.9L, 0.1L);
+    CHECK(std::fabs(infolerp::js_divergence(p, q, 0.9) - static_cast<double>(two_way)) < tolerance);
+    const std::vector<float> pf(p.begin(), p.end()), qf(q.begin(), q.end());
+    CHECK(std::fabs(infolerp::js_divergence(pf, qf, 0.9) - static_cast<double>(two_way)) < tolerance);
+    // Unnormalised input: the checked API's normalising sum of n entries 0.1 must be exact enough.
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(p3, q_tenths, 0.9)) - static_cast<double>(two_way)) < tolerance);
+    const double w[] = {0.9, 0.1};
+    const std::span<const double> normalised[] = {p, q}, unnormalised[] = {p3, q_tenths};
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(normalised, w)) - static_cast<double>(n_ary)) < tolerance);
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(unnormalised, w)) - static_cast<double>(n_ary)) < tolerance);
+  }
+}
+
 TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
   // The portable kernel (SSE2 under GCC/Clang) against the AVX2 and AVX-512 copies the CPU
   // has: lengths 1..300 (every tail), float and double rows, scaled and unscaled, random
