@@ -396,6 +396,16 @@ TEST_CASE("n-ary JS: agrees with the two-way form, closed forms, errors") {
   CHECK(e.error().element() == 1);
   const double zero_w[] = {0.0, 0.0, 0.0};
   CHECK(infolerp::jensen_shannon(three, zero_w).error().code() == infolerp::errc::bad_parameter);
+  // Finite weights whose sum overflows are valid weights: 3:1 and 1:1 as the two-way form.
+  constexpr double huge = std::numeric_limits<double>::max();
+  const double w_huge[] = {huge, huge / 3}, w_equal_huge[] = {huge, huge};
+  CHECK(checked(infolerp::jensen_shannon(two, w_huge)) == Approx(infolerp::js_divergence(p, q, 0.75)).margin(1e-14));
+  CHECK(checked(infolerp::jensen_shannon(two, w_equal_huge)) == Approx(infolerp::js_divergence(p, q, 0.5)).margin(1e-14));
+  // Messages print numbers in shortest form.
+  const double w_big_negative[] = {1e300, -1e300};
+  e = infolerp::jensen_shannon(two, w_big_negative);
+  CHECK(e.error().code() == infolerp::errc::bad_parameter);
+  CHECK(e.error().message() == "infolerp: jensen_shannon: weight 1 is -1e+300 (must be finite and >= 0)");
   const std::vector<double> shorter(299, 1.0);
   const std::span<const double> mismatched[] = {p, shorter};
   CHECK(infolerp::jensen_shannon(mismatched, w2).error().element() == 1);

@@ -437,7 +437,8 @@ inline result<double> jensen_shannon(std::span<const float> p, std::span<const f
 }
 
 // n-ary weighted JS: Σ_i π_i Σ_y p_i(y) log₂(p_i(y)/m(y)), m = Σ_i π_i p_i, in [0, log₂ n].
-// Each distribution is normalised by its sum and the weights by theirs.
+// Each distribution is normalised by its sum and the weights by theirs (any finite weights:
+// when their sum overflows they are scaled by a power of two first).
 // Errors: no distributions (empty_input); weights.size() != distributions.size() (bad_size);
 // a negative, NaN or Inf weight, or all weights 0 (bad_parameter, element() = the weight);
 // distributions of different sizes (bad_distribution, element() = the distribution); bad
@@ -448,14 +449,19 @@ inline result<double> jensen_shannon(std::span<const std::span<const double>> di
   if (k == 0) return make_error(errc::empty_input, no_element, "jensen_shannon: no distributions");
   if (weights.size() != k)
     return make_error(errc::bad_size, no_element, "jensen_shannon: ", weights.size(), " weights for ", k, " distributions");
-  double weight_sum = 0.0;
+  double weight_sum = 0.0, weight_scale = 1.0;
   for (std::size_t i = 0; i < k; ++i) {
     if (!std::isfinite(weights[i]) || weights[i] < 0.0)
       return make_error(errc::bad_parameter, i, "jensen_shannon: weight ", i, " is ", weights[i], " (must be finite and >= 0)");
     weight_sum += weights[i];
   }
-  if (!(weight_sum > 0.0) || !std::isfinite(weight_sum))
-    return make_error(errc::bad_parameter, no_element, "jensen_shannon: weights sum to ", weight_sum);
+  if (!std::isfinite(weight_sum)) {  // finite weights whose sum overflows: scale by 2^-64 (exact)
+    weight_scale = 0x1p-64;
+    weight_sum = 0.0;
+    for (const double w : weights) weight_sum += w * weight_scale;
+  }
+  if (!(weight_sum > 0.0))
+    return make_error(errc::bad_parameter, no_element, "jensen_shannon: weights sum to 0 (all ", k, " are 0)");
   const std::size_t bins = distributions[0].size();
   struct input {
     detail::distribution_scale scale;
@@ -471,7 +477,7 @@ inline result<double> jensen_shannon(std::span<const std::span<const double>> di
                         " bins, distribution 0 has ", bins);
     auto s = detail::check_distribution(distributions[i], "jensen_shannon", "distribution", i);
     if (!s) return s.error();
-    inputs[i] = {*s, weights[i] / weight_sum};
+    inputs[i] = {*s, weights[i] * weight_scale / weight_sum};
   }
   const auto entry = [&](std::size_t i, std::size_t y) { return distributions[i][y] * inputs[i].scale.pre * inputs[i].scale.inv; };
   detail::compensated_sum sum;  // bins add up without the error growing with their count
