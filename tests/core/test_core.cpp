@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <vector>
 #include "infolerp/core/executor.hpp"
@@ -63,6 +64,17 @@ TEST_CASE("status and result carry the error and the element") {
   CHECK_FALSE(e.ok());
   CHECK(e.error().message() == bad.message());
   CHECK(std::string(infolerp::to_string(infolerp::errc::non_finite)) == "non-finite value");
+  // Floating-point numbers in their shortest round-trip form, neither 300 digits nor 0.000000.
+  const auto text = [](auto x) { return infolerp::make_error(infolerp::errc::bad_parameter, 0, "epsilon ", x).message(); };
+  CHECK(text(1e300) == "infolerp: epsilon 1e+300");
+  CHECK(text(1e-20) == "infolerp: epsilon 1e-20");
+  CHECK(text(0.1) == "infolerp: epsilon 0.1");
+  CHECK(text(0.1f) == "infolerp: epsilon 0.1");
+  CHECK(text(-2.5) == "infolerp: epsilon -2.5");
+  CHECK(text(std::numeric_limits<double>::denorm_min()) == "infolerp: epsilon 5e-324");
+  CHECK(text(std::numeric_limits<double>::infinity()) == "infolerp: epsilon inf");
+  CHECK(text(std::numeric_limits<double>::quiet_NaN()) == "infolerp: epsilon nan");
+  CHECK(text(std::numeric_limits<long double>::max()).size() < 18 + 32);  // "infolerp: epsilon " + the number
 }
 
 TEST_CASE("mesh concepts: members, traits specialisation, optional capabilities") {

@@ -154,6 +154,34 @@ TEST_CASE("JS adversarial: subnormals, p == q up to the last bit, float32, a mil
   }
 }
 
+TEST_CASE("JS accuracy does not decay with the bin count: one-hot against uniform, weights 0.9/0.1") {
+  // Closed form in long double: bin 0 has p = 1, q = 1/n; the other n - 1 bins p = 0, q = 1/n.
+  const auto closed_form = [](std::size_t n, long double wp, long double wq) {
+    const long double u = 1.0L / static_cast<long double>(n), m0 = wp + wq * u;
+    return wp * std::log2(1.0L / m0) + wq * u * std::log2(u / m0) +
+           static_cast<long double>(n - 1) * wq * u * std::log2(1.0L / wq);
+  };
+  // Every bin's term is >= 0 and JS is 0.47 here: about 18 roundings of it bound the summation.
+  constexpr double tolerance = 1e-15;
+  for (std::size_t n : {std::size_t{4096}, std::size_t{1} << 16, std::size_t{1} << 20}) {
+    CAPTURE(n);
+    std::vector<double> p(n, 0.0), q(n, 1.0 / static_cast<double>(n)), p3(n, 0.0), q_tenths(n, 0.1);
+    p[0] = 1.0;
+    p3[0] = 3.0;
+    // The two-way kernel weighs q by 1 - 0.9 in double (exact, Sterbenz); the n-ary form by 0.1.
+    const long double two_way = closed_form(n, 0.9L, 1.0L - 0.9L), n_ary = closed_form(n, 0.9L, 0.1L);
+    CHECK(std::fabs(infolerp::js_divergence(p, q, 0.9) - static_cast<double>(two_way)) < tolerance);
+    const std::vector<float> pf(p.begin(), p.end()), qf(q.begin(), q.end());
+    CHECK(std::fabs(infolerp::js_divergence(pf, qf, 0.9) - static_cast<double>(two_way)) < tolerance);
+    // Unnormalised input: the checked API's normalising sum of n entries 0.1 must be exact enough.
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(p3, q_tenths, 0.9)) - static_cast<double>(two_way)) < tolerance);
+    const double w[] = {0.9, 0.1};
+    const std::span<const double> normalised[] = {p, q}, unnormalised[] = {p3, q_tenths};
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(normalised, w)) - static_cast<double>(n_ary)) < tolerance);
+    CHECK(std::fabs(checked(infolerp::jensen_shannon(unnormalised, w)) - static_cast<double>(n_ary)) < tolerance);
+  }
+}
+
 TEST_CASE("JS kernel: the same bits on every ISA the dispatcher can pick") {
   // The portable kernel (SSE2 under GCC/Clang) against the AVX2 and AVX-512 copies the CPU
   // has: lengths 1..300 (every tail), float and double rows, scaled and unscaled, random
@@ -368,6 +396,16 @@ TEST_CASE("n-ary JS: agrees with the two-way form, closed forms, errors") {
   CHECK(e.error().element() == 1);
   const double zero_w[] = {0.0, 0.0, 0.0};
   CHECK(infolerp::jensen_shannon(three, zero_w).error().code() == infolerp::errc::bad_parameter);
+  // Finite weights whose sum overflows are valid weights: 3:1 and 1:1 as the two-way form.
+  constexpr double huge = std::numeric_limits<double>::max();
+  const double w_huge[] = {huge, huge / 3}, w_equal_huge[] = {huge, huge};
+  CHECK(checked(infolerp::jensen_shannon(two, w_huge)) == Approx(infolerp::js_divergence(p, q, 0.75)).margin(1e-14));
+  CHECK(checked(infolerp::jensen_shannon(two, w_equal_huge)) == Approx(infolerp::js_divergence(p, q, 0.5)).margin(1e-14));
+  // Messages print numbers in shortest form.
+  const double w_big_negative[] = {1e300, -1e300};
+  e = infolerp::jensen_shannon(two, w_big_negative);
+  CHECK(e.error().code() == infolerp::errc::bad_parameter);
+  CHECK(e.error().message() == "infolerp: jensen_shannon: weight 1 is -1e+300 (must be finite and >= 0)");
   const std::vector<double> shorter(299, 1.0);
   const std::span<const double> mismatched[] = {p, shorter};
   CHECK(infolerp::jensen_shannon(mismatched, w2).error().element() == 1);

@@ -3,6 +3,7 @@
 // The library throws nothing and builds with -fno-exceptions -fno-rtti; a failing entry point
 // returns a status whose message names the offending element (triangle 17, bin 3, ...).
 #include <cassert>
+#include <charconv>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -104,13 +105,20 @@ class [[nodiscard]] result {
 };
 
 namespace detail {
-// Builds messages without iostreams: text as is, numbers in decimal.
+// Builds messages without iostreams: text as is, integers in decimal, floating-point numbers
+// in their shortest round-trip form (std::to_chars: 1e+300, 0.1, 5e-324, nan, inf).
 inline void append_part(std::string& s, const char* part) { s += part; }
 inline void append_part(std::string& s, const std::string& part) { s += part; }
 template <class N>
-  requires std::is_arithmetic_v<N>
+  requires std::is_integral_v<N>
 void append_part(std::string& s, N part) {
   s += std::to_string(part);
+}
+template <class N>
+  requires std::is_floating_point_v<N>
+void append_part(std::string& s, N part) {
+  char text[64];  // the shortest form of a long double takes at most about 30 characters
+  s.append(text, std::to_chars(text, text + sizeof text, part).ptr);
 }
 }  // namespace detail
 

@@ -1,7 +1,8 @@
 #pragma once
 // Entropy, conditional entropy, mutual information of an information channel X → Y, and the
 // per-element mutual information I(x;Y) (Cover & Thomas ch. 2; clustering paper §3.1 and
-// §3.2.2, where the element with the largest I(x;Y) becomes the first seed). All in bits.
+// §3.2.2, where the element with the minimum I(x;Y), the most representative, becomes the
+// first seed). All in bits.
 //
 // A channel is given as p(x) (size X) and its rows p(Y|x), row-major (size X·Y).
 // Robust forms only: every quantity is a sum of per-term contributions p·log₂(p/q) in double,
