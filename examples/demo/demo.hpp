@@ -29,7 +29,7 @@ struct demo_options {
   int height = 1025;
   int threads = 0;                   // --threads N (0 = all cores); every stage uses this many
   std::filesystem::path out_dir = "infolerp-out";  // --out DIR
-  std::string mesh_path;             // --mesh FILE (empty: built-in scene only)
+  std::vector<std::string> mesh_paths;  // --mesh FILE, repeatable (none: built-in scene only)
   support::shader_options shader;    // --ao N, --soft N
   std::uint32_t passes = 4;          // --passes K: I-Buffer passes of ibuffer.png; 0 = auto (pass controller)
   std::map<std::string, float> thresholds;  // --threshold CHANNEL=VALUE: channel (visibility,

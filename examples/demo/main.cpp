@@ -25,7 +25,8 @@ namespace {
 
 constexpr const char* usage =
     "usage: infolerp_demo [options]\n"
-    "  --mesh FILE     add a mesh (OFF/OBJ/PLY/... via assimp) to the built-in scene\n"
+    "  --mesh FILE     add an asset to the built-in scene (repeatable): OBJ+MTL, glTF/GLB, PLY, OFF\n"
+    "                  (via assimp); one object per material, shaded with its diffuse texture\n"
     "  --size W H      image size in pixels (default 1025 1025)\n"
     "  --passes K|auto I-Buffer passes of ibuffer.png (1-16, default 4); auto: the pass controller\n"
     "                  (frame-time bounds 1/60-1/30 s, at most 4 passes)\n"
@@ -84,7 +85,7 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
       std::exit(0);
     } else if (arg == "--mesh") {
       if (!need(1)) return fail("--mesh needs a file name");
-      o.mesh_path = argv[++i];
+      o.mesh_paths.emplace_back(argv[++i]);
     } else if (arg == "--size") {
       if (!need(2) || !parse_int(argv[i + 1], 1, 16384, o.width) || !parse_int(argv[i + 2], 1, 16384, o.height))
         return fail("--size needs two integers W H in [1, 16384]");
@@ -158,7 +159,7 @@ int main(int argc, char** argv) {
   support::enable_flush_to_zero();
   const std::string embree_config = options->threads > 0 ? "threads=" + std::to_string(options->threads) : "";
   const support::embree_device device(embree_config.c_str());
-  auto scene = support::make_demo_scene(device, {.mesh_path = options->mesh_path});
+  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths});
   if (!scene) {
     demo::report(scene.error());
     return 1;
@@ -166,8 +167,18 @@ int main(int argc, char** argv) {
   std::size_t triangles = 0;
   for (const auto& object : scene->objects) triangles += object.mesh.triangle_count();
   std::printf("scene: %zu objects, %zu triangles\n", scene->objects.size(), triangles);
+  for (const auto& object : scene->objects) {
+    const auto& image = object.mat.image;
+    if (image)
+      std::printf("  %s: %zu triangles, texture %dx%d (%zu mip levels)\n", object.name.c_str(), object.mesh.triangle_count(),
+                  image->width(), image->height(), image->level_count());
+    else if (!object.note.empty())
+      std::printf("  %s: %zu triangles, %s\n", object.name.c_str(), object.mesh.triangle_count(), object.note.c_str());
+  }
 
-  const support::reference_shader shader(*scene, options->shader);
+  support::shader_options shading = options->shader;
+  shading.pixel_angle = support::pixel_angle(scene->view, options->height);  // mip levels from the footprint
+  const support::reference_shader shader(*scene, shading);
   if (!options->thresholds.empty()) {
     std::printf("thresholds:");
     for (const auto& [channel, value] : options->thresholds) std::printf(" %s=%g", channel.c_str(), static_cast<double>(value));

@@ -149,13 +149,13 @@ TEST_CASE("bad inputs: empty image, unreadable mesh", "[shader]") {
   support::image out;
   CHECK_FALSE(support::render_reference(shader, 0, 10, out).ok());
   CHECK_FALSE(support::render_reference(shader, 10, -1, out).ok());
-  auto missing = support::make_demo_scene(device(), {.mesh_path = "/nonexistent/mesh.off"});
+  auto missing = support::make_demo_scene(device(), {.mesh_paths = {"/nonexistent/mesh.off"}});
   REQUIRE_FALSE(missing.ok());
   CHECK(missing.error().message().find("/nonexistent/mesh.off") != std::string::npos);
 }
 
 TEST_CASE("a user mesh is fitted onto the ground at the requested size", "[shader]") {
-  auto built = support::make_demo_scene(device(), {.mesh_path = support::cgal_mesh("fandisk"), .mesh_size = 1.5f});
+  auto built = support::make_demo_scene(device(), {.mesh_paths = {support::cgal_mesh("fandisk")}, .mesh_size = 1.5f});
   REQUIRE(built.ok());
   REQUIRE(built->objects.size() == 5u);
   const auto& m = built->objects.back().mesh;

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/validate.hpp"
+#include "infolerp/mesh/adaptors.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
@@ -35,15 +36,20 @@ pinhole_rays camera::rays() const {
   return r;
 }
 
+float pixel_angle(const camera& c, int height) {
+  return 2.0f * std::tan(0.5f * c.vertical_fov_degrees * pi / 180.0f) / static_cast<float>(height);
+}
+
 ray camera::primary_ray(float x, float y, int width, int height) const { return rays()(x, y, width, height); }
 
 glm::vec3 area_light::normal() const { return glm::normalize(glm::cross(edge_u, edge_v)); }
 float area_light::area() const { return glm::length(glm::cross(edge_u, edge_v)); }
 
-glm::vec3 albedo(const material& mat, glm::vec2 uv) {
+glm::vec3 albedo(const material& mat, glm::vec2 uv, float lod) {
   const glm::vec2 p = uv * mat.repeat;
   switch (mat.texture) {
     case texture_kind::solid: return mat.color_a;
+    case texture_kind::image: return mat.color_a * mat.image->trilinear(p, lod);
     case texture_kind::checker: {
       const auto cell = static_cast<long>(std::floor(p.x)) + static_cast<long>(std::floor(p.y));
       return (cell & 1) == 0 ? mat.color_a : mat.color_b;
@@ -61,6 +67,18 @@ glm::vec3 albedo(const material& mat, glm::vec2 uv) {
     }
   }
   return mat.color_a;
+}
+
+float texel_density(const indexed_mesh& m, const texture& image) {
+  if (!m.has_texcoords()) return 0.0f;
+  double uv_area = 0.0, area = 0.0;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const glm::dvec2 a(m.texcoord(t, 0)), b(m.texcoord(t, 1)), c(m.texcoord(t, 2));
+    uv_area += 0.5 * std::abs((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+    area += 0.5 * glm::length(area_vector(corners(m, t)));
+  }
+  const double texels = uv_area * image.width() * image.height();
+  return area > 0.0 && texels > 0.0 ? static_cast<float>(std::sqrt(texels / area)) : 0.0f;
 }
 
 std::vector<glm::vec3> vertex_normals(const indexed_mesh& m) {
@@ -88,22 +106,57 @@ indexed_mesh transformed(const indexed_mesh& src, const glm::mat4& m) {
   return out;
 }
 
-// Loads the user's mesh (Y-up, as most OBJ/OFF/PLY files are: turned to this scene's Z-up) and
-// scales it so its largest extent is `size`, standing on the ground at `where` (x, y).
-// OFF files are read as written (read_off) and every mesh is validated before use: indices in
-// range, finite positions (all vertices, as they all enter the bounds). Degenerate triangles and
-// non-manifold edges are accepted: the tracer and the demo's stages handle them.
-result<indexed_mesh> load_fitted_mesh(const std::string& path, float size, glm::vec2 where) {
-  const bool off = path.size() >= 4 && (path.ends_with(".off") || path.ends_with(".OFF"));
-  auto loaded = off ? read_off(path) : load_mesh(path);
-  if (!loaded) return loaded.error();
-  if (auto s = validate_mesh(*loaded, {.allow_degenerate = true, .allow_non_manifold = true, .check_unused_vertices = true}); !s) {
-    std::string_view m = s.message();
-    if (m.starts_with("infolerp: ")) m.remove_prefix(10);
-    return make_error(s.code(), s.element(), "mesh '", path, "': ", std::string(m));
+// The same keeping the normals, for a rotation with uniform scale and translation.
+indexed_mesh moved(const indexed_mesh& src, const glm::mat4& m) {
+  indexed_mesh out = transformed(src, m);
+  out.normals.reserve(src.normals.size());
+  for (const glm::vec3& n : src.normals) out.normals.push_back(glm::mat3(m) * n);
+  return out;
+}
+
+// Validates a loaded mesh: indices in range, finite positions (all vertices, as they all enter
+// the bounds). Degenerate triangles and non-manifold edges are accepted: the tracer and the
+// demo's stages handle them.
+status check_mesh(const indexed_mesh& m, const std::string& path) {
+  if (auto s = validate_mesh(m, {.allow_degenerate = true, .allow_non_manifold = true, .check_unused_vertices = true}); !s) {
+    std::string_view text = s.message();
+    if (text.starts_with("infolerp: ")) text.remove_prefix(10);
+    return make_error(s.code(), s.element(), "mesh '", path, "': ", std::string(text));
   }
-  *loaded = transformed(*loaded, glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f)));
-  const bounding_box box = mesh_bounds(*loaded);
+  return {};
+}
+
+// An asset's parts: OFF files are read as written (read_off, one untextured part), anything
+// else through assimp (load_textured_mesh, one part per material). Every part is validated.
+result<std::vector<textured_part>> load_parts(const std::string& path) {
+  std::vector<textured_part> parts;
+  if (path.ends_with(".off") || path.ends_with(".OFF")) {
+    auto m = read_off(path);
+    if (!m) return m.error();
+    parts.push_back({"", std::move(*m), glm::vec3(0.75f, 0.72f, 0.68f), nullptr, "no texcoords: stretch channel skipped, solid colour"});
+  } else {
+    auto loaded = load_textured_mesh(path);
+    if (!loaded) return loaded.error();
+    parts = std::move(*loaded);
+  }
+  for (const auto& part : parts)
+    if (auto s = check_mesh(part.mesh, path); !s) return s;
+  return parts;
+}
+
+// Loads an asset (Y-up, as most OBJ/glTF/OFF/PLY files are: turned to this scene's Z-up), scales
+// it so its largest extent is `size`, standing on the ground at `where` (x, y), one object per
+// part. Normals the file lacks are area-weighted vertex normals; the file's are turned with it.
+result<std::vector<scene_object>> load_fitted_asset(const std::string& path, float size, glm::vec2 where) {
+  auto parts = load_parts(path);
+  if (!parts) return parts.error();
+  const glm::mat4 up = glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f));
+  indexed_mesh all;
+  for (auto& part : *parts) {
+    part.mesh = moved(part.mesh, up);
+    append(all, part.mesh);
+  }
+  const bounding_box box = mesh_bounds(all);
   const glm::dvec3 extent = box.hi - box.lo;
   const double largest = std::max({extent.x, extent.y, extent.z});
   if (!(largest > 0.0) || !std::isfinite(largest))
@@ -114,8 +167,20 @@ result<indexed_mesh> load_fitted_mesh(const std::string& path, float size, glm::
   glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(where, 0.0f));
   m = glm::scale(m, glm::vec3(s));
   m = glm::translate(m, -base);
-  indexed_mesh out = transformed(*loaded, m);
-  out.normals = vertex_normals(out);
+  std::vector<scene_object> out;
+  for (auto& part : *parts) {
+    indexed_mesh mesh = moved(part.mesh, m);
+    if (!mesh.has_normals()) mesh.normals = vertex_normals(mesh);
+    for (auto& n : mesh.normals) n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 0.0f, 1.0f);
+    material mat{texture_kind::solid, part.diffuse, {}, {1.0f, 1.0f}, 0.3f, nullptr, 0.0f};
+    if (part.image && mesh.has_texcoords()) {
+      mat.texture = texture_kind::image;
+      mat.image = part.image;
+      mat.texels_per_unit = texel_density(mesh, *part.image);
+    }
+    const std::string name = parts->size() == 1 && part.material.empty() ? path : path + " [" + part.material + "]";
+    out.push_back({name, std::move(mesh), std::move(mat), std::move(part.note)});
+  }
   return out;
 }
 
@@ -159,10 +224,15 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
     objects.push_back({"boxes", std::move(boxes), {texture_kind::solid, {0.55f, 0.6f, 0.55f}, {}, {1.0f, 1.0f}, 0.0f}});
   }
 
-  if (!options.mesh_path.empty()) {
-    auto user = load_fitted_mesh(options.mesh_path, options.mesh_size, {0.2f, -2.4f});
+  // Assets side by side along x in front of the built-in objects, then a row further back.
+  for (std::size_t i = 0; i < options.mesh_paths.size(); ++i) {
+    const float step = options.mesh_size * 1.2f;
+    const std::size_t k = i % 5;  // columns at 0, +1, -1, +2, -2 steps
+    const float column = static_cast<float>((k + 1) / 2) * (k % 2 == 1 ? 1.0f : -1.0f);
+    const glm::vec2 where{0.2f + column * step, -2.4f - static_cast<float>(i / 5) * step};
+    auto user = load_fitted_asset(options.mesh_paths[i], options.mesh_size, where);
     if (!user) return user.error();
-    objects.push_back({options.mesh_path, std::move(*user), {texture_kind::solid, {0.75f, 0.72f, 0.68f}, {}, {1.0f, 1.0f}, 0.3f}});
+    for (auto& object : *user) objects.push_back(std::move(object));
   }
 
   embree_scene tracer{device};

@@ -1,9 +1,11 @@
 #pragma once
 // The built-in demo scene (procedural, no downloads): a brick-textured ground plane, a
 // checker-textured UV sphere (its texture stretches toward the poles), a torus, boxes that cast
-// hard shadows, an optional user mesh (--mesh FILE), a pinhole camera, a sun (hard shadow) and
+// hard shadows, optional user assets (--mesh FILE, repeatable; textured, one object per
+// material), a pinhole camera, a sun (hard shadow) and
 // a rectangular area light (soft shadow). Z is up. Shared by the demo, tests and benchmarks.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +16,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 #include "support/embree_tracer.hpp"
+#include "support/texture.hpp"
 
 namespace infolerp::support {
 
@@ -48,6 +51,9 @@ struct camera {
   pinhole_rays rays() const;
 };
 
+// The angle one pixel spans at the centre of a `height`-pixel-high image of camera c (radians).
+float pixel_angle(const camera& c, int height);
+
 // A directional light with hard shadows. direction points toward the sun (unit length).
 struct sun_light {
   glm::vec3 direction{0.0f, 0.0f, 1.0f};
@@ -68,17 +74,21 @@ struct area_light {
   float area() const;
 };
 
-// Procedural textures looked up through interpolated texcoords.
-enum class texture_kind : std::uint8_t { solid, checker, brick };
+// Procedural textures looked up through interpolated texcoords, or an image texture.
+enum class texture_kind : std::uint8_t { solid, checker, brick, image };
 struct material {
   texture_kind texture = texture_kind::solid;
-  glm::vec3 color_a{0.7f};              // solid colour, checker even cells, bricks
+  glm::vec3 color_a{0.7f};              // solid colour, checker even cells, bricks, image factor
   glm::vec3 color_b{0.2f};              // checker odd cells, mortar
   glm::vec2 repeat{1.0f};               // texture cells per unit of texcoord (u, v)
   float specular = 0.0f;                // Blinn-Phong weight (white highlight)
+  std::shared_ptr<const support::texture> image{};  // texture_kind::image: the texture (mips)
+  float texels_per_unit = 0.0f;         // image: level-0 texels per world unit on the mesh (mean
+                                        // over its area), which turns a footprint into a mip level
 };
-// Albedo of `mat` at texcoord uv (pure, deterministic).
-glm::vec3 albedo(const material& mat, glm::vec2 uv);
+// Albedo of `mat` at texcoord uv (pure, deterministic). lod: log2 of the sample footprint in
+// level-0 texels of an image texture (trilinear mip lookup); procedural textures ignore it.
+glm::vec3 albedo(const material& mat, glm::vec2 uv, float lod = 0.0f);
 
 // One object of the scene: objects[g] is the tracer's geometry g. Meshes with per-vertex normals
 // are shaded smooth, the others flat; texcoords, when present, drive the material's texture.
@@ -86,6 +96,7 @@ struct scene_object {
   std::string name;
   indexed_mesh mesh;
   material mat;
+  std::string note{};  // for loaded assets: what is missing (texcoords, texture) and what that skips
 };
 
 struct demo_scene {
@@ -104,8 +115,8 @@ struct demo_scene {
 };
 
 struct demo_scene_options {
-  std::string mesh_path;          // a real mesh (OFF/OBJ/PLY ... via assimp) to add; empty: none
-  float mesh_size = 1.8f;         // the user mesh is scaled so its largest extent is this
+  std::vector<std::string> mesh_paths;  // real assets (OFF/OBJ/glTF/PLY ... via assimp) to add
+  float mesh_size = 1.8f;         // each asset is scaled so its largest extent is this
   unsigned sphere_slices = 64;    // UV sphere tessellation
   unsigned sphere_stacks = 32;
   unsigned torus_major = 64;      // torus tessellation
@@ -113,9 +124,15 @@ struct demo_scene_options {
   unsigned ground_cells = 16;     // ground plane quads per side
 };
 
-// Builds the scene on `device` and commits its tracer. Errors: the user mesh cannot be loaded
-// (the message names the file) or has no triangles Embree accepts.
+// Builds the scene on `device` and commits its tracer. Each asset adds one object per material
+// (named "FILE [material]"), textured when the material has a diffuse texture and the mesh
+// texcoords; assets stand side by side in front of the built-in objects. Errors: an asset or
+// its texture cannot be loaded (the message names the file) or has no triangles Embree accepts.
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options = {});
+
+// Level-0 texels per world unit of `image` on mesh m: sqrt(texture area covered / surface area),
+// both summed over the triangles (0 without texcoords or area).
+float texel_density(const indexed_mesh& m, const texture& image);
 
 // Area-weighted vertex normals (unit; (0,0,1) for a vertex whose triangles have no area).
 std::vector<glm::vec3> vertex_normals(const indexed_mesh& m);

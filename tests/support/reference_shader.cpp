@@ -158,7 +158,10 @@ glm::vec3 reference_shader::shade(const shading_inputs& in) const {
     const float cos_light = std::max(0.0f, -glm::dot(l, scene.area.normal()));
     irradiance += scene.area.radiance * (scene.area.area() * cos_surface * cos_light / (pi * dist2) * in.soft_shadow);
   }
-  return albedo(mat, in.uv) * irradiance + highlight;
+  float lod = 0.0f;  // log2 of the footprint in level-0 texels (texture.hpp)
+  if (mat.texture == texture_kind::image && options_.pixel_angle > 0.0f)
+    lod = std::log2(glm::distance(in.position, rays_.eye) * options_.pixel_angle * mat.texels_per_unit);
+  return albedo(mat, in.uv, lod) * irradiance + highlight;
 }
 
 result<render_stats> render_reference(const reference_shader& shader, int width, int height, image& out, int threads,

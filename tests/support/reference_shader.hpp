@@ -28,6 +28,10 @@ struct shader_options {
   unsigned soft_shadow_rays = 16;  // M: rays to fixed points on the area light (0 = light off)
   bool packets = false;            // trace a pixel's AO and soft-shadow rays as 16-ray packets
   bool hard_shadow = true;         // trace the sun's hard-shadow ray (false: light_bits stay 0)
+  float pixel_angle = 0.0f;        // radians per pixel of the rendered image (pixel_angle(camera,
+                                   // height)): image textures take the mip level of the sample's
+                                   // footprint, distance x pixel_angle across (isotropic: the
+                                   // surface's tilt is ignored); 0: always level 0 (bilinear)
 };
 
 // What evaluate() finds at a pixel: everything shade() needs. Interpolating records (not
