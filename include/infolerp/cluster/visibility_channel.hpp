@@ -551,11 +551,19 @@ struct visibility_channel {
   // (triangle, viewpoint) first traces P probe samples spread over its n² (indices ⌊j·n²/P⌋);
   // when every probe faces the viewpoint and all are free (or all occluded), the other samples
   // are counted the same without tracing (free ones only where they face it); otherwise they
-  // are traced. Rule: agreement of the probes alone (neighbouring triangles are not consulted).
+  // are traced. Rule: agreement of the probes alone (see adaptive_neighbours for the stricter rule).
   // Error: an entry is wrong only where a shadow or silhouette edge crosses the triangle
   // between probes, by at most (n² − P)/n² of OR; benchmarks/NOTES.md has the measured JS and
   // ARI. 0 (or P >= n²) traces every sample. Implies the grouped path (as with coherent).
   std::uint32_t adaptive_probes = 0;
+  // Neighbour rule for adaptive_probes: the rest of (t, v) is skipped only when t's probes agree
+  // and every edge neighbour's probes toward v agree the same way (all faced and free, or all
+  // faced and occluded); otherwise traced. All probes are traced first (a second pass traces the
+  // rest), holding one verdict byte per (triangle, viewpoint): T·N bytes more.
+  // Error: every pair traced by the probe rule alone is traced here too, so each entry is exact
+  // or equals the probe rule's (off by at most (n² − P)/n² of OR), and no more entries are wrong
+  // than with probes alone; benchmarks/NOTES.md has the measured JS and ARI.
+  bool adaptive_neighbours = false;
   // The paper's measurement (cluster/visibility_images.hpp): with images = true, OR(t, v) =
   // min(1, a/u) from one image_resolution² image of primary rays per viewpoint, stored as
   // round(255·OR) (error ≤ 1/510 from rounding). Triangles projecting to fewer than
@@ -631,7 +639,18 @@ struct visibility_channel {
       for (std::size_t t = 0; t < nt; ++t) order[t] = static_cast<std::uint32_t>(t);
     }
     const detail::visibility_hull hull = cull_hull ? detail::make_visibility_hull(m, su) : detail::visibility_hull{};
-    const std::size_t chunks = chunk_count(nt, g), per_wave = 64;
+    // The neighbour rule runs the probes of every triangle first (phase 0), keeping their verdicts
+    // (0 all occluded, 1 traced, 2 all free) per (triangle, viewpoint), then the rest (phase 1).
+    const bool two_phases = probes > 0 && adaptive_neighbours;
+    std::vector<std::uint8_t> verdict(two_phases ? nt * nv : 0);
+    auto neighbour_verdict = [&](std::uint32_t t, std::size_t v) -> std::uint8_t {
+      const std::uint8_t own = verdict[std::size_t{t} * nv + v];
+      for (std::uint32_t k = p.neighbour_offsets[t]; own != 1 && k < p.neighbour_offsets[t + 1]; ++k)
+        if (verdict[std::size_t{p.neighbours[k]} * nv + v] != own) return 1;
+      return own;
+    };
+    const std::size_t chunks = chunk_count(nt, g), per_wave = 64, phases = two_phases ? 2 : 1;
+    for (std::size_t phase = 0; phase < phases; ++phase)
     for (std::size_t w0 = 0; w0 < chunks; w0 += per_wave) {
       const std::size_t w1 = std::min(chunks, w0 + per_wave);
       exec.parallel_for(w1 - w0, 1, [&](std::size_t cb, std::size_t ce) {
@@ -657,7 +676,11 @@ struct visibility_channel {
           const std::span<const std::uint32_t> tris(order.data() + first, last - first);
           auto count = [&](std::uint32_t slot) { ++p.visible[std::size_t{tris[slot / nv]} * nv + slot % nv]; };
           const detail::visibility_hull* h = cull_hull ? &hull : nullptr;
-          if (probes > 0) {  // the probes, then the rest where they disagree
+          if (probes > 0 && phase == 1) {  // the rest where the probes or the neighbours' disagree
+            mode.resize(tris.size() * nv);
+            for (std::size_t q = 0; q < mode.size(); ++q) mode[q] = neighbour_verdict(tris[q / nv], q % nv);
+            detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, rest_on, mode);
+          } else if (probes > 0) {  // the probes, then the rest where they disagree
             detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, probe_on);
             hit.resize(rays.size());
             trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
@@ -673,7 +696,9 @@ struct visibility_channel {
               const auto slot = static_cast<std::uint32_t>(q);
               for (std::uint8_t f = 0; f < free_probes[q]; ++f) count(slot);
               mode[q] = faced[q] < probes ? 1 : free_probes[q] == probes ? 2 : free_probes[q] == 0 ? 0 : 1;
+              if (two_phases) verdict[std::size_t{tris[q / nv]} * nv + q % nv] = mode[q];
             }
+            if (two_phases) continue;
             rays.clear();
             slots.clear();
             free_slots.clear();
@@ -687,7 +712,7 @@ struct visibility_channel {
           for (std::uint32_t slot : free_slots) count(slot);
         }
       });
-      if (progress) progress(std::min(nt, w1 * g), nt);
+      if (progress) progress((phase * nt + std::min(nt, w1 * g)) / phases, nt);
     }
     return p;
   }
