@@ -19,8 +19,13 @@
 // (rtcOccluded1M, flagged coherent) instead of 16-ray packets.
 // Beside the CSV: FILE.png (seconds against mean_js, gnuplot) and FILE.gp (its script), with a
 // trailing .csv of FILE replaced.
-// Also printed: min and median seconds per row, and the peak RSS of the process.
+// Also printed: min and median seconds per row, the peak RSS of the process, and per mesh the
+// peak memory (VmHWM) of a forked child that loads the mesh, builds the Embree scenes and runs
+// one prepare() of the default, of the largest image and of the neighbour rule, against the
+// child's VmHWM before prepare() and the T·N bytes of counts.
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -106,7 +111,27 @@ std::vector<config> configs() {
         c.adaptive_probes = probes;
       });
       out.back().stream = true;
+      std::snprintf(setting, sizeof setting, "n%u_P%u_stream", n, probes);
+      with("adaptive_neighbours", setting, [=](visibility_channel& c) {
+        c.coherent = true;
+        c.samples_per_side = n;
+        c.adaptive_probes = probes;
+        c.adaptive_neighbours = true;
+      });
+      out.back().stream = true;
     }
+  // The paper's measurement: one image per viewpoint (resolution R, fallback under M pixels).
+  for (const auto& [res, min_pixels] : std::vector<std::pair<std::uint32_t, double>>{
+           {256, 4.0}, {512, 1.0}, {512, 4.0}, {512, 16.0}, {1024, 4.0}}) {
+    char setting[32];
+    std::snprintf(setting, sizeof setting, "r%u_m%g_stream", res, min_pixels);
+    with("images", setting, [=](visibility_channel& c) {
+      c.images = true;
+      c.image_resolution = res;
+      c.image_min_pixels = min_pixels;
+    });
+    out.back().stream = true;
+  }
   return out;
 }
 
@@ -124,6 +149,53 @@ std::vector<std::uint32_t> visibility_clusters(const indexed_mesh& m, const coun
 visibility_state raw_rows(prepared_visibility_channel p, std::span<const std::uint32_t> all) {
   p.denoise = false;
   return std::move(*p.init(all));
+}
+
+// VmHWM of this process in MB (0 when /proc is not there).
+double vm_hwm_mb() {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return 0.0;
+  char line[256];
+  double kb = 0.0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::strncmp(line, "VmHWM:", 6) == 0) kb = std::atof(line + 6);
+  std::fclose(f);
+  return kb / 1024.0;
+}
+
+// The peak memory of one prepare() of `c` on mesh `name`, in a forked child (before anything of
+// the run is allocated in the parent): prints the child's VmHWM before and after.
+void report_peak_memory(const std::string& name, const config& c) {
+  int fd[2];
+  if (pipe(fd) != 0) return;
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fd[0]);
+    double out[3] = {0.0, 0.0, 0.0};
+    auto m = support::load_mesh(support::cgal_mesh(name));
+    auto topo = m ? build_topology(*m) : result<mesh_topology>(make_error(errc::empty_input, no_element, "no mesh"));
+    if (m && topo) {
+      support::embree_device device("threads=1");
+      support::embree_scene scene(device, {.coherent_streams = c.stream});
+      if (scene.add_mesh(*m) && scene.commit()) {
+        serial_executor exec;
+        out[0] = vm_hwm_mb();
+        auto p = c.channel.prepare(*m, *topo, scene, exec);
+        out[1] = p ? vm_hwm_mb() : 0.0;
+        out[2] = static_cast<double>(m->triangles.size() * c.channel.viewpoints) / (1024.0 * 1024.0);
+      }
+    }
+    const ssize_t wrote = write(fd[1], out, sizeof out);
+    _exit(wrote == static_cast<ssize_t>(sizeof out) ? 0 : 1);
+  }
+  close(fd[1]);
+  double in[3] = {0.0, 0.0, 0.0};
+  const ssize_t got = child > 0 ? read(fd[0], in, sizeof in) : 0;
+  close(fd[0]);
+  if (child > 0) waitpid(child, nullptr, 0);
+  if (got == static_cast<ssize_t>(sizeof in))
+    std::printf("%s %s %s: VmHWM %.1f MB before prepare(), %.1f MB after (counts T*N = %.1f MB)\n", name.c_str(),
+                c.option.c_str(), c.setting.c_str(), in[0], in[1], in[2]);
 }
 
 double peak_rss_mb() {
@@ -174,6 +246,18 @@ int pareto_visibility(int argc, char** argv) {
   std::fprintf(csv, "mesh,option,setting,seconds,rays,mean_js,max_js,ari,ari_self\n");
   support::enable_flush_to_zero();
   const std::vector<config> cfg = configs();
+  for (std::size_t start = 0; start <= meshes.size();) {
+    std::size_t end = meshes.find(',', start);
+    if (end == std::string::npos) end = meshes.size();
+    const std::string name = meshes.substr(start, end - start);
+    start = end + 1;
+    if (name.empty()) continue;
+    for (const config& c : cfg)
+      if (c.option == "default" || (c.option == "images" && c.setting.starts_with("r1024")) ||
+          (c.option == "adaptive_neighbours" && c.setting == "n3_P2_stream"))
+        report_peak_memory(name, c);
+  }
+  std::fflush(stdout);
   std::size_t start = 0;
   while (start <= meshes.size()) {
     std::size_t end = meshes.find(',', start);

@@ -26,6 +26,7 @@
 // Building blocks: channels, one-channel clustering, information theory, geometry, refinement.
 #include "infolerp/cluster/channel.hpp"
 #include "infolerp/cluster/visibility_channel.hpp"
+#include "infolerp/cluster/visibility_images.hpp"
 #include "infolerp/cluster/orientation_channel.hpp"
 #include "infolerp/cluster/stretch_channel.hpp"
 #include "infolerp/cluster/region_growing.hpp"

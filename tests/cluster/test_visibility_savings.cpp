@@ -184,6 +184,20 @@ TEST_CASE("visibility adaptive sampling: the probe rule, its bound, and determin
       c.grain = 5;
       support::thread_pool_executor pool{2};
       REQUIRE(c.prepare(m, *topo, scene, pool)->visible == a->visible);
+      // The neighbour rule: each entry exact or the probe rule's, fewer entries wrong.
+      c.adaptive_neighbours = true;
+      auto b = c.prepare(m, *topo, scene, serial);
+      REQUIRE(b.ok());
+      std::size_t wrong_neighbours = 0, repaired = 0;
+      for (std::size_t i = 0; i < b->visible.size(); ++i) {
+        REQUIRE((b->visible[i] == base->visible[i] || b->visible[i] == a->visible[i]));
+        wrong_neighbours += b->visible[i] != base->visible[i] ? 1 : 0;
+        repaired += b->visible[i] == base->visible[i] && a->visible[i] != base->visible[i] ? 1 : 0;
+      }
+      INFO("with neighbours: " << wrong_neighbours << " entries differ, " << repaired << " repaired");
+      REQUIRE(wrong_neighbours < wrong);
+      REQUIRE(repaired > 0);
+      REQUIRE(c.prepare(m, *topo, scene, pool)->visible == b->visible);
     }
   }
 }

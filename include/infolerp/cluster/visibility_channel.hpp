@@ -25,7 +25,8 @@
 // Rays: N·n² per triangle at most, traced in batches (trace_occluded uses the tracer's batch
 // overload when it has one), chunks of `grain` triangles in parallel through the executor.
 // Options cut them: `coherent` and `cull_hull` exactly (the same counts), `adaptive_probes`
-// approximately (see visibility_channel).
+// approximately (see visibility_channel). Option `images` measures OR the paper's way instead:
+// one image of primary rays per viewpoint (cluster/visibility_images.hpp).
 // OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
@@ -45,6 +46,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/cluster/channel.hpp"
+#include "infolerp/cluster/visibility_images.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/large_buffer.hpp"
 #include "infolerp/core/mesh_traits.hpp"
@@ -367,8 +369,8 @@ struct prepared_visibility_channel {
   double threshold = 0.48;
   bool denoise = true;
   std::size_t viewpoints = 0;
-  std::uint32_t samples = 0;           // n² per triangle
-  std::vector<std::uint8_t> visible;   // T × N: samples with a free ray toward v
+  std::uint32_t samples = 0;           // the count meaning OR = 1: n² per triangle (255 with images)
+  std::vector<std::uint8_t> visible;   // T × N: samples with a free ray toward v (round(255·OR) with images)
   std::vector<std::uint32_t> neighbour_offsets, neighbours;  // the mesh's dual graph
 
   // OR(t, v) in [0, 1].
@@ -549,11 +551,28 @@ struct visibility_channel {
   // (triangle, viewpoint) first traces P probe samples spread over its n² (indices ⌊j·n²/P⌋);
   // when every probe faces the viewpoint and all are free (or all occluded), the other samples
   // are counted the same without tracing (free ones only where they face it); otherwise they
-  // are traced. Rule: agreement of the probes alone (neighbouring triangles are not consulted).
+  // are traced. Rule: agreement of the probes alone (see adaptive_neighbours for the stricter rule).
   // Error: an entry is wrong only where a shadow or silhouette edge crosses the triangle
   // between probes, by at most (n² − P)/n² of OR; benchmarks/NOTES.md has the measured JS and
   // ARI. 0 (or P >= n²) traces every sample. Implies the grouped path (as with coherent).
   std::uint32_t adaptive_probes = 0;
+  // Neighbour rule for adaptive_probes: the rest of (t, v) is skipped only when t's probes agree
+  // and every edge neighbour's probes toward v agree the same way (all faced and free, or all
+  // faced and occluded); otherwise traced. All probes are traced first (a second pass traces the
+  // rest), holding one verdict byte per (triangle, viewpoint): T·N bytes more.
+  // Error: every pair traced by the probe rule alone is traced here too, so each entry is exact
+  // or equals the probe rule's (off by at most (n² − P)/n² of OR), and no more entries are wrong
+  // than with probes alone; benchmarks/NOTES.md has the measured JS and ARI.
+  bool adaptive_neighbours = false;
+  // The paper's measurement (cluster/visibility_images.hpp): with images = true, OR(t, v) =
+  // min(1, a/u) from one image_resolution² image of primary rays per viewpoint, stored as
+  // round(255·OR) (error ≤ 1/510 from rounding). Triangles projecting to fewer than
+  // image_min_pixels pixels, or not wholly in the view, use the n² sample rays. The mesh must be
+  // geometry 0 of the tracer's scene. Not combinable with cull_hull or adaptive_probes
+  // (coherent has no effect: rays already go viewpoint by viewpoint).
+  bool images = false;
+  std::uint32_t image_resolution = 512;  // 1..16384
+  double image_min_pixels = 4.0;         // >= 0
 
   // The viewpoints and samples this configuration uses for mesh m.
   template <class M>
@@ -578,16 +597,31 @@ struct visibility_channel {
                         " outside 1..15");
     if (!(radius_scale >= 1.0) || !std::isfinite(radius_scale))
       return make_error(errc::bad_parameter, no_element, "visibility channel: radius_scale ", radius_scale, " must be >= 1");
+    if (images) {
+      if (image_resolution == 0 || image_resolution > 16384)
+        return make_error(errc::bad_parameter, no_element, "visibility channel: image_resolution ", image_resolution,
+                          " outside 1..16384");
+      if (!(image_min_pixels >= 0.0) || !std::isfinite(image_min_pixels))
+        return make_error(errc::bad_parameter, no_element, "visibility channel: image_min_pixels ", image_min_pixels,
+                          " must be finite and >= 0");
+      if (cull_hull || (adaptive_probes > 0 && adaptive_probes < samples_per_side * samples_per_side))
+        return make_error(errc::bad_parameter, no_element,
+                          "visibility channel: images cannot be combined with cull_hull or adaptive_probes");
+    }
     const std::size_t nt = mesh_triangle_count(m), nv = viewpoints;
     const visibility_setup su = setup(m);
     prepared_visibility_channel p;
     p.threshold = threshold;
     p.denoise = denoise;
     p.viewpoints = nv;
-    p.samples = static_cast<std::uint32_t>(su.samples.size());
+    p.samples = images ? 255u : static_cast<std::uint32_t>(su.samples.size());
     p.visible.assign(nt * nv, 0);
     p.neighbour_offsets = topo.neighbour_offsets;
     p.neighbours = topo.neighbours;
+    if (images) {
+      prepare_images(m, su, tr, exec, p);
+      return p;
+    }
     const std::size_t g = std::max<std::size_t>(grain, 1);
     const std::size_t ns = su.samples.size();
     const std::size_t probes = adaptive_probes < ns ? adaptive_probes : 0;
@@ -605,7 +639,18 @@ struct visibility_channel {
       for (std::size_t t = 0; t < nt; ++t) order[t] = static_cast<std::uint32_t>(t);
     }
     const detail::visibility_hull hull = cull_hull ? detail::make_visibility_hull(m, su) : detail::visibility_hull{};
-    const std::size_t chunks = chunk_count(nt, g), per_wave = 64;
+    // The neighbour rule runs the probes of every triangle first (phase 0), keeping their verdicts
+    // (0 all occluded, 1 traced, 2 all free) per (triangle, viewpoint), then the rest (phase 1).
+    const bool two_phases = probes > 0 && adaptive_neighbours;
+    std::vector<std::uint8_t> verdict(two_phases ? nt * nv : 0);
+    auto neighbour_verdict = [&](std::uint32_t t, std::size_t v) -> std::uint8_t {
+      const std::uint8_t own = verdict[std::size_t{t} * nv + v];
+      for (std::uint32_t k = p.neighbour_offsets[t]; own != 1 && k < p.neighbour_offsets[t + 1]; ++k)
+        if (verdict[std::size_t{p.neighbours[k]} * nv + v] != own) return 1;
+      return own;
+    };
+    const std::size_t chunks = chunk_count(nt, g), per_wave = 64, phases = two_phases ? 2 : 1;
+    for (std::size_t phase = 0; phase < phases; ++phase)
     for (std::size_t w0 = 0; w0 < chunks; w0 += per_wave) {
       const std::size_t w1 = std::min(chunks, w0 + per_wave);
       exec.parallel_for(w1 - w0, 1, [&](std::size_t cb, std::size_t ce) {
@@ -631,7 +676,11 @@ struct visibility_channel {
           const std::span<const std::uint32_t> tris(order.data() + first, last - first);
           auto count = [&](std::uint32_t slot) { ++p.visible[std::size_t{tris[slot / nv]} * nv + slot % nv]; };
           const detail::visibility_hull* h = cull_hull ? &hull : nullptr;
-          if (probes > 0) {  // the probes, then the rest where they disagree
+          if (probes > 0 && phase == 1) {  // the rest where the probes or the neighbours' disagree
+            mode.resize(tris.size() * nv);
+            for (std::size_t q = 0; q < mode.size(); ++q) mode[q] = neighbour_verdict(tris[q / nv], q % nv);
+            detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, rest_on, mode);
+          } else if (probes > 0) {  // the probes, then the rest where they disagree
             detail::make_grouped_visibility_rays(m, su, tris, coherent, h, scratch, rays, slots, free_slots, probe_on);
             hit.resize(rays.size());
             trace_occluded(tr, std::span<const ray>(rays), std::span<std::uint8_t>(hit));
@@ -647,7 +696,9 @@ struct visibility_channel {
               const auto slot = static_cast<std::uint32_t>(q);
               for (std::uint8_t f = 0; f < free_probes[q]; ++f) count(slot);
               mode[q] = faced[q] < probes ? 1 : free_probes[q] == probes ? 2 : free_probes[q] == 0 ? 0 : 1;
+              if (two_phases) verdict[std::size_t{tris[q / nv]} * nv + q % nv] = mode[q];
             }
+            if (two_phases) continue;
             rays.clear();
             slots.clear();
             free_slots.clear();
@@ -661,9 +712,27 @@ struct visibility_channel {
           for (std::uint32_t slot : free_slots) count(slot);
         }
       });
-      if (progress) progress(std::min(nt, w1 * g), nt);
+      if (progress) progress((phase * nt + std::min(nt, w1 * g)) / phases, nt);
     }
     return p;
+  }
+
+ private:
+  // Option `images`: viewpoints in parallel (one task each, waves of 8 between progress calls),
+  // each writing only its own column of counts.
+  template <class M, class T, class E>
+  void prepare_images(const M& m, const visibility_setup& su, const T& tr, E& exec, prepared_visibility_channel& p) const {
+    const std::size_t nt = mesh_triangle_count(m), nv = su.viewpoints.size(), per_wave = 8;
+    const bounding_box box = mesh_bounds(m);
+    for (std::size_t w0 = 0; w0 < nv; w0 += per_wave) {
+      const std::size_t w1 = std::min(nv, w0 + per_wave);
+      exec.parallel_for(w1 - w0, 1, [&](std::size_t vb, std::size_t ve) {
+        for (std::size_t v = w0 + vb; v < w0 + ve; ++v)
+          detail::image_occlusion_ratios(m, tr, su.viewpoints[v], box, image_resolution, image_min_pixels, su.samples,
+                                         su.offset, 255.0, p.visible.data() + v, nv);
+      });
+      if (progress) progress(nt * w1 / nv, nt);
+    }
   }
 };
 
