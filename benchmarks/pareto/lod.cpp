@@ -6,7 +6,7 @@
 // View-dependent multiresolution rendering (salient-clustering paper §III.C, §IV) against
 // meshoptimizer's meshopt_simplify, the simplifier an engine would otherwise call.
 //
-// CSV: kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff
+// CSV: kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr,ssim
 //   kind=simplify, per mesh (bunny00, armadillo, refined_elephant, each --mesh) and fraction
 //   (0.35, 0.10, 0.05, 0.01 of the triangles): method infolerp (seconds: building the hierarchy
 //   plus one selection of its global prefix to that triangle count) or meshoptimizer (one
@@ -14,8 +14,10 @@
 //   vertex positions. Distances, the same code for both: weighted_distance = Σ_v S(v)·d(v) / Σ S,
 //   d(v) the distance from original vertex v to the simplified surface and S the mesh saliency
 //   (compute_saliency, defaults); hausdorff = the larger of max_v d(v) and the largest distance
-//   from a simplified triangle's vertices, edge midpoints and centroid to the original surface.
-//   Closest points come from a uniform grid of triangles searched in growing shells (exact).
+//   from a simplified triangle's vertices, edge midpoints and centroid to the original surface
+//   (support/surface_distance.hpp). psnr, ssim: the means over 8 views of the reference shader's
+//   256x256 images (AO 16, soft shadow 4 rays) of the simplified mesh against the full mesh's
+//   (support/mesh_views.hpp); empty for frame rows.
 //   Seconds: the minimum of --reps repetitions, the methods interleaved in one loop.
 //   The hierarchy is built with backstop 0.005 (half a percent of the vertices, about 1% of the
 //   triangles), so that the 1% row exists, and in one global order (cluster_local_first off, as
@@ -41,6 +43,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -52,131 +55,18 @@
 #include "infolerp/saliency/salient_clustering.hpp"
 #include "pareto.hpp"
 #include "support/mesh_io.hpp"
+#include "support/mesh_views.hpp"
 #include "support/procedural.hpp"
+#include "support/surface_distance.hpp"
 
 namespace {
 
 using namespace infolerp;
 using clk = std::chrono::steady_clock;
+using support::distances;
+using support::measure;
 
 double seconds_since(clk::time_point t0) { return std::chrono::duration<double>(clk::now() - t0).count(); }
-
-// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection §5.1.5).
-glm::dvec3 closest_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const glm::dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const glm::dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
-// Exact point-to-surface distance through a uniform grid of triangle boxes.
-class surface_distance {
- public:
-  surface_distance(const std::vector<glm::vec3>& pos, std::span<const std::uint32_t> idx) : pos_(pos), idx_(idx) {
-    bounding_box box;
-    for (std::uint32_t v : idx) box.extend(glm::dvec3(pos[v]));
-    lo_ = box.lo;
-    const std::size_t nt = idx.size() / 3;
-    const glm::dvec3 ext = box.hi - box.lo;
-    h_ = std::max(std::cbrt(ext.x * ext.y * ext.z / std::max<double>(1.0, static_cast<double>(nt))), 1e-9 * box.diagonal());
-    for (int a = 0; a < 3; ++a) n_[a] = std::max(1, static_cast<int>(std::ceil(ext[a] / h_)));
-    cells_.resize(static_cast<std::size_t>(n_[0]) * static_cast<std::size_t>(n_[1]) * static_cast<std::size_t>(n_[2]));
-    for (std::size_t t = 0; t < nt; ++t) {
-      glm::dvec3 l(std::numeric_limits<double>::max()), u(-std::numeric_limits<double>::max());
-      for (int j = 0; j < 3; ++j) {
-        l = glm::min(l, glm::dvec3(pos[idx[3 * t + static_cast<std::size_t>(j)]]));
-        u = glm::max(u, glm::dvec3(pos[idx[3 * t + static_cast<std::size_t>(j)]]));
-      }
-      const glm::ivec3 cl = cell(l), cu = cell(u);
-      for (int x = cl.x; x <= cu.x; ++x)
-        for (int y = cl.y; y <= cu.y; ++y)
-          for (int z = cl.z; z <= cu.z; ++z) cells_[index(x, y, z)].push_back(static_cast<std::uint32_t>(t));
-    }
-    seen_.assign(nt, 0);
-  }
-  double operator()(const glm::dvec3& p) {
-    const glm::ivec3 c = cell(p);
-    double best = std::numeric_limits<double>::max();
-    ++stamp_;
-    const int rmax = std::max({n_[0], n_[1], n_[2]});
-    for (int r = 0; r <= rmax; ++r) {
-      for (int x = c.x - r; x <= c.x + r; ++x)
-        for (int y = c.y - r; y <= c.y + r; ++y)
-          for (int z = c.z - r; z <= c.z + r; ++z) {
-            if (std::max({std::abs(x - c.x), std::abs(y - c.y), std::abs(z - c.z)}) != r) continue;
-            if (x < 0 || y < 0 || z < 0 || x >= n_[0] || y >= n_[1] || z >= n_[2]) continue;
-            for (std::uint32_t t : cells_[index(x, y, z)]) {
-              if (seen_[t] == stamp_) continue;
-              seen_[t] = stamp_;
-              const glm::dvec3 q = closest_on_triangle(p, glm::dvec3(pos_[idx_[3 * t]]), glm::dvec3(pos_[idx_[3 * t + 1]]),
-                                                       glm::dvec3(pos_[idx_[3 * t + 2]]));
-              best = std::min(best, glm::length(q - p));
-            }
-          }
-      if (best <= static_cast<double>(r) * h_) break;  // unsearched cells are at least r·h away
-    }
-    return best;
-  }
-
- private:
-  glm::ivec3 cell(const glm::dvec3& p) const {
-    glm::ivec3 c;
-    for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>(std::floor((p[a] - lo_[a]) / h_)), 0, n_[a] - 1);
-    return c;
-  }
-  std::size_t index(int x, int y, int z) const {
-    return (static_cast<std::size_t>(x) * static_cast<std::size_t>(n_[1]) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(n_[2]) +
-           static_cast<std::size_t>(z);
-  }
-  const std::vector<glm::vec3>& pos_;
-  std::span<const std::uint32_t> idx_;
-  glm::dvec3 lo_{0.0};
-  double h_ = 1.0;
-  int n_[3] = {1, 1, 1};
-  std::vector<std::vector<std::uint32_t>> cells_;
-  std::vector<std::uint32_t> seen_;
-  std::uint32_t stamp_ = 0;
-};
-
-struct distances {
-  double weighted = 0.0, hausdorff = 0.0;
-};
-
-distances measure(const indexed_mesh& m, const std::vector<double>& saliency, std::span<const std::uint32_t> simplified) {
-  distances out;
-  surface_distance to_simplified(m.positions, simplified);
-  std::vector<char> used(m.vertex_count(), 0);
-  for (const auto& t : m.triangles) used[t.x] = used[t.y] = used[t.z] = 1;
-  double num = 0.0, den = 0.0;
-  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-    if (!used[v]) continue;
-    const double d = to_simplified(glm::dvec3(m.positions[v]));
-    num += saliency[v] * d, den += saliency[v];
-    out.hausdorff = std::max(out.hausdorff, d);
-  }
-  out.weighted = den > 0.0 ? num / den : 0.0;
-  const std::span<const std::uint32_t> original(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * m.triangle_count());
-  surface_distance to_original(m.positions, original);
-  for (std::size_t k = 0; k < simplified.size(); k += 3) {
-    const glm::dvec3 a(m.positions[simplified[k]]), b(m.positions[simplified[k + 1]]), c(m.positions[simplified[k + 2]]);
-    for (const glm::dvec3& p : {a, b, c, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), (a + b + c) / 3.0})
-      out.hausdorff = std::max(out.hausdorff, to_original(p));
-  }
-  return out;
-}
 
 struct prepared {
   std::vector<double> saliency;
@@ -208,16 +98,31 @@ std::uint32_t prefix_for(const contraction_hierarchy& h, std::size_t target) {
 }
 
 void row(std::FILE* csv, const char* kind, const std::string& mesh, const char* method, double f, std::size_t tris,
-         double sec, const distances* d) {
+         double sec, const distances* d, const support::view_similarity* v = nullptr) {
   for (std::FILE* o : {csv, stdout}) {
     std::fprintf(o, "%s,%s,%s,%.2f,%zu,%.6g,", kind, mesh.c_str(), method, f, tris, sec);
-    if (d) std::fprintf(o, "%.6g,%.6g\n", d->weighted, d->hausdorff);
+    if (d) std::fprintf(o, "%.6g,%.6g,", d->weighted, d->hausdorff);
+    else std::fprintf(o, ",,");
+    if (v) std::fprintf(o, "%.4f,%.6f\n", v->psnr, v->ssim);
     else std::fprintf(o, ",\n");
   }
   std::fflush(csv);
 }
 
-void simplify_rows(std::FILE* csv, const std::string& name, const indexed_mesh& m, int reps) {
+// Mean PSNR / SSIM of the 8 reference-shader views of a simplified index buffer against those
+// of the full mesh (support/mesh_views.hpp); nothing when rendering fails (reported).
+std::optional<support::view_similarity> view_scores(const support::embree_device& device, const indexed_mesh& m,
+                                                    std::span<const std::uint32_t> simplified,
+                                                    const std::vector<support::image>& full) {
+  auto views = support::render_mesh_views(device, m.positions, simplified);
+  if (!views) return std::fprintf(stderr, "views: %s\n", views.error().message().c_str()), std::nullopt;
+  auto sim = support::compare_views(*views, full);
+  if (!sim) return std::fprintf(stderr, "views: %s\n", sim.error().message().c_str()), std::nullopt;
+  return *sim;
+}
+
+void simplify_rows(std::FILE* csv, const support::embree_device& device, const std::string& name, const indexed_mesh& m,
+                   int reps) {
   prepared p;
   if (!prepare(m, p)) return;
   const std::size_t nt = m.triangle_count();
@@ -257,14 +162,21 @@ void simplify_rows(std::FILE* csv, const std::string& name, const indexed_mesh& 
               name.c_str(), nt, h.contraction_count(), build_min,
               [&] { auto v = build_s; std::sort(v.begin(), v.end()); return v[v.size() / 2]; }(),
               static_cast<double>(h.memory_bytes()) / static_cast<double>(nt));
+  const std::span<const std::uint32_t> original(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * nt);
+  auto full_views = support::render_mesh_views(device, m.positions, original);
+  if (!full_views) return void(std::fprintf(stderr, "views: %s\n", full_views.error().message().c_str()));
   for (std::size_t i = 0; i < fractions.size(); ++i) {
     auto mn = [&](const std::vector<double>& s) {
       return *std::min_element(s.begin() + static_cast<long>(i) * reps, s.begin() + static_cast<long>(i + 1) * reps);
     };
     const distances ours = measure(m, p.saliency, our_out[i]);
     const distances theirs = measure(m, p.saliency, mo_out[i]);
-    row(csv, "simplify", name, "infolerp", fractions[i], our_out[i].size() / 3, build_min + mn(sel_s), &ours);
-    row(csv, "simplify", name, "meshoptimizer", fractions[i], mo_out[i].size() / 3, mn(mo_s), &theirs);
+    const auto our_views = view_scores(device, m, our_out[i], *full_views);
+    const auto their_views = view_scores(device, m, mo_out[i], *full_views);
+    row(csv, "simplify", name, "infolerp", fractions[i], our_out[i].size() / 3, build_min + mn(sel_s), &ours,
+        our_views ? &*our_views : nullptr);
+    row(csv, "simplify", name, "meshoptimizer", fractions[i], mo_out[i].size() / 3, mn(mo_s), &theirs,
+        their_views ? &*their_views : nullptr);
   }
 }
 
@@ -360,7 +272,7 @@ int pareto_lod(int argc, char** argv) {
   }
   std::FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (!csv) return std::fprintf(stderr, "cannot write %s\n", csv_path.c_str()), 1;
-  std::fprintf(csv, "kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff\n");
+  std::fprintf(csv, "kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr,ssim\n");
   std::vector<std::pair<std::string, std::string>> meshes;
   if (builtin)
     for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));
@@ -369,13 +281,15 @@ int pareto_lod(int argc, char** argv) {
     const std::size_t b = slash == std::string::npos ? 0 : slash + 1;
     meshes.emplace_back(path.substr(b, dot == std::string::npos || dot < b ? std::string::npos : dot - b), path);
   }
+  support::enable_flush_to_zero();
+  const support::embree_device device;
   for (const auto& [name, path] : meshes) {
     auto m = support::load_mesh(path);
     if (!m.ok()) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), m.error().message().c_str());
       continue;
     }
-    simplify_rows(csv, name, *m, reps);
+    simplify_rows(csv, device, name, *m, reps);
   }
   if (frames) frame_rows(csv, reps);
   std::fclose(csv);
