@@ -51,6 +51,36 @@ void BM_Saliency_Exact(benchmark::State& state) {
 }
 BENCHMARK(BM_Saliency_Exact)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
+// bunny00 and the same mesh plus one triangle reaching a vertex `far` bounding-box diagonals
+// away. Arg 0: bunny00 alone (the reference). Arg 1: the stray vertex 1e6 diagonals away with
+// epsilon scaled down so that sigma is bunny00's: the same pairs as bunny00, so the time shows
+// what the neighbour grid costs. Arg 2: the stray vertex 100 diagonals away with the default
+// epsilon: sigma grows with the diagonal, every ball holds the whole bunny and the pairs are all
+// pairs, by the definition (epsilon relative to the bounding box), not by the grid.
+void BM_Saliency_StrayVertex(benchmark::State& state) {
+  static std::optional<infolerp::indexed_mesh> bunny = [] {
+    auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("bunny00"));
+    return m.ok() ? std::optional(std::move(*m)) : std::nullopt;
+  }();
+  if (!bunny) return state.SkipWithError("bunny00 not found");
+  infolerp::indexed_mesh m = *bunny;
+  infolerp::saliency_options opt;
+  if (state.range(0) > 0) {
+    const auto box = infolerp::mesh_bounds(m);
+    const double far = state.range(0) == 1 ? 1e6 : 100.0;
+    m.positions.push_back(glm::vec3(box.hi) + glm::vec3(static_cast<float>(far * box.diagonal()), 0.0f, 0.0f));
+    m.triangles.push_back({0u, 1u, static_cast<unsigned>(m.positions.size() - 1)});
+    if (state.range(0) == 1) opt.epsilon *= box.diagonal() / infolerp::mesh_bounds(m).diagonal();
+  }
+  for (auto _ : state) {
+    auto s = infolerp::compute_saliency(m, opt, infolerp::openmp_executor{2});
+    if (!s.ok()) return state.SkipWithError(s.error().message().c_str());
+    benchmark::DoNotOptimize(s->saliency.data());
+  }
+  state.counters["vertices"] = static_cast<double>(m.positions.size());
+}
+BENCHMARK(BM_Saliency_StrayVertex)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_Saliency_Approx(benchmark::State& state) {
   const auto* m = elephant_subdivided();
   const auto* exact = elephant_exact_saliency();

@@ -119,6 +119,28 @@ TEST_CASE("saliency: fast exact path matches the O(V^2) definition to 1e-9") {
   }
 }
 
+TEST_CASE("saliency: a far stray vertex leaves the neighbour grid as fine as the ball asks") {
+  auto m = bumpy_plane(24, {{0.3f, -0.2f}}, 0.3f, 0.15f);
+  const double diagonal = infolerp::mesh_bounds(m).diagonal();
+  m.positions.push_back({1e6f, 0.0f, 0.0f});
+  m.triangles.push_back({0u, 1u, static_cast<unsigned>(m.positions.size() - 1)});
+  // sigma as on the plane alone: 0.03 of its diagonal.
+  const infolerp::saliency_options opt{.epsilon = 0.03 * diagonal / infolerp::mesh_bounds(m).diagonal()};
+  auto s = infolerp::compute_saliency(m, opt);
+  REQUIRE(s.ok());
+  const auto ref = brute_force(m, opt);
+  CHECK(max_abs_diff(s->saliency, ref.saliency) <= 1e-9);
+
+  std::vector<double> curvature(m.positions.size(), 0.0);
+  const auto used = infolerp::detail::referenced_vertices(m);
+  const auto points = infolerp::detail::referenced_point_grid(m, used, curvature, 1.0);
+  const double width = 0.5 * s->epsilon;
+  infolerp::serial_executor serial;
+  const auto grid = infolerp::detail::make_column_grid(serial, points, width);
+  CHECK(grid.h == width);
+  CHECK(grid.col_key.size() <= m.positions.size());
+}
+
 TEST_CASE("saliency: identical bits for any executor, thread count and grain") {
   const auto m = bumpy_plane(60, {{0.0f, 0.0f}, {0.5f, 0.5f}}, 0.2f, 0.1f);
   infolerp::saliency_options opt{.epsilon = 0.01};

@@ -222,21 +222,29 @@ inline std::size_t aligned_offset(const std::vector<double>& v) {
   return misalign == 0 ? 0 : (block_lanes * sizeof(double) - misalign) / sizeof(double);
 }
 
-// Points sorted into columns of an xy grid, by z (then id) inside each column, so the points of
-// one column within a z interval are one contiguous run (found by binary search).
+// Points sorted into the columns of an xy grid, by z (then id) inside each column, so the points
+// of one column within a z interval are one contiguous run (found by binary search). Sparse:
+// only occupied columns are stored, ordered by (cx, cy), so memory and time follow the points,
+// not the bounding box (one far vertex leaves the other columns as fine as without it).
 struct column_grid {
   std::vector<double> rows;               // sorted points: x, y, z, value rows (see row)
   std::size_t points = 0, stride = 0, offset = 0;
   std::vector<std::uint32_t> src;         // index of each sorted point in the source point_grid
-  std::vector<std::uint32_t> col_start;   // columns + 1 offsets into the sorted points
+  std::vector<std::uint64_t> col_key;     // occupied columns, ascending: cx << 32 | cy
+  std::vector<std::uint32_t> col_start;   // occupied columns + 1 offsets into the sorted points
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
-  std::uint32_t nx = 1, ny = 1;
   // Row r (0 x, 1 y, 2 z, 3 value), 64-byte aligned (unless the grid was copied).
   const double* row(std::size_t r) const { return rows.data() + offset + r * stride; }
+  static std::uint64_t key(std::uint32_t cx, std::uint32_t cy) { return std::uint64_t{cx} << 32 | cy; }
+  // Index of column (cx, cy) among the occupied ones, or col_key.size() when it is empty.
+  std::size_t find(std::uint32_t cx, std::uint32_t cy) const {
+    const auto it = std::lower_bound(col_key.begin(), col_key.end(), key(cx, cy));
+    return it != col_key.end() && *it == key(cx, cy) ? static_cast<std::size_t>(it - col_key.begin()) : col_key.size();
+  }
 };
 
-// Builds a column_grid with columns about `width` wide (wider when needed to keep the column
-// count O(points)). O(P log P); the columns are sorted in parallel through exec.
+// Builds a column_grid with columns `width` wide (wider only when a coordinate would pass 2^31
+// columns). O(P log P), allocation O(P); the columns are sorted in parallel through exec.
 template <class E>
 column_grid make_column_grid(E& exec, const point_grid& g, double width) {
   column_grid c;
@@ -245,25 +253,27 @@ column_grid make_column_grid(E& exec, const point_grid& g, double width) {
   for (std::size_t k = 0; k < P; ++k)
     xlo = std::min(xlo, g.x[k]), xhi = std::max(xhi, g.x[k]), ylo = std::min(ylo, g.y[k]), yhi = std::max(yhi, g.y[k]);
   double h = width > 0.0 ? width : 1.0;
-  const double max_cols = 4.0 * static_cast<double>(P) + 64.0;
-  while ((std::floor((xhi - xlo) / h) + 1.0) * (std::floor((yhi - ylo) / h) + 1.0) > max_cols) h *= 1.25;
+  while (std::max(xhi - xlo, yhi - ylo) / h >= 2147483647.0) h *= 2.0;
   c.x0 = xlo, c.y0 = ylo, c.h = h;
-  c.nx = static_cast<std::uint32_t>(std::floor((xhi - xlo) / h)) + 1;
-  c.ny = static_cast<std::uint32_t>(std::floor((yhi - ylo) / h)) + 1;
-  auto col = [&](std::size_t k) {
-    const auto cx = std::min(static_cast<std::uint32_t>((g.x[k] - xlo) / h), c.nx - 1);
-    const auto cy = std::min(static_cast<std::uint32_t>((g.y[k] - ylo) / h), c.ny - 1);
-    return cx * c.ny + cy;
-  };
-  std::vector<std::uint32_t> order(P);
-  c.col_start.assign(std::size_t{c.nx} * c.ny + 1, 0);
-  for (std::size_t k = 0; k < P; ++k) ++c.col_start[col(k) + 1];
-  for (std::size_t q = 0; q + 1 < c.col_start.size(); ++q) c.col_start[q + 1] += c.col_start[q];
-  {
-    std::vector<std::uint32_t> cursor(c.col_start.begin(), c.col_start.end() - 1);
-    for (std::size_t k = 0; k < P; ++k) order[cursor[col(k)]++] = static_cast<std::uint32_t>(k);
+  const auto nx = static_cast<std::uint32_t>(std::floor((xhi - xlo) / h)) + 1;
+  const auto ny = static_cast<std::uint32_t>(std::floor((yhi - ylo) / h)) + 1;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
+  for (std::size_t k = 0; k < P; ++k) {
+    const auto cx = std::min(static_cast<std::uint32_t>((g.x[k] - xlo) / h), nx - 1);
+    const auto cy = std::min(static_cast<std::uint32_t>((g.y[k] - ylo) / h), ny - 1);
+    keyed[k] = {column_grid::key(cx, cy), static_cast<std::uint32_t>(k)};
   }
-  exec.parallel_for(c.col_start.size() - 1, 64, [&](std::size_t b, std::size_t e) {
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(P);
+  for (std::size_t k = 0; k < P; ++k) {
+    order[k] = keyed[k].second;
+    if (k == 0 || keyed[k].first != keyed[k - 1].first) {
+      c.col_key.push_back(keyed[k].first);
+      c.col_start.push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+  c.col_start.push_back(static_cast<std::uint32_t>(P));
+  exec.parallel_for(c.col_key.size(), 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t q = b; q < e; ++q)
       std::sort(order.begin() + c.col_start[q], order.begin() + c.col_start[q + 1], [&](std::uint32_t x, std::uint32_t y) {
         return g.z[x] != g.z[y] ? g.z[x] < g.z[y] : g.id[x] < g.id[y];
@@ -406,11 +416,29 @@ inline double* point_sums(double* sums, std::size_t L, std::size_t j, std::size_
   return sums + j / block_lanes * (2 * block_lanes * L) + u * 2 * block_lanes + j % block_lanes;
 }
 
-// A tile: the columns [cx0, cx1) × [cy0, cy1) of a column_grid.
+// A tile: the occupied columns of a column_grid within span × span column positions, in
+// (cx, cy) order.
 struct column_tile {
-  std::uint32_t cx0, cx1, cy0, cy1;
-  std::uint32_t points;  // in the tile
+  const std::uint32_t* cols;  // column indices (into col_key)
+  std::uint32_t count;        // columns in the tile
+  std::uint32_t points;       // points in the tile
 };
+
+// An occupied column near another: its index and grid position.
+struct column_ref {
+  std::size_t q;
+  std::uint32_t ax, ay;
+};
+
+// The occupied columns that a point of column (cx, cy) meets: its own, the later ones in its
+// x, and those up to span later in x and span either side in y, in (x, y) order.
+inline void columns_after(const column_grid& g, std::uint32_t cx, std::uint32_t cy, std::uint32_t span,
+                          std::vector<column_ref>& near) {
+  near.clear();
+  for (std::uint32_t ax = cx; ax <= cx + span; ++ax)
+    for (std::uint32_t ay = ax == cx ? cy : (cy > span ? cy - span : 0); ay <= cy + span; ++ay)
+      if (const std::size_t q = g.find(ax, ay); q < g.col_key.size()) near.push_back({q, ax, ay});
+}
 
 #if defined(__clang__)
 #define INFOLERP_SALIENCY_UNROLL _Pragma("unroll 8")
@@ -436,15 +464,17 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
   const std::size_t L = t.r2.size();
   const double r2max = t.r2[L - 1];
   const double *px_all = g.row(0), *py_all = g.row(1), *pz_all = g.row(2), *pc_all = g.row(3);
-  for (std::uint32_t cx = tile.cx0; cx < tile.cx1; ++cx)
-    for (std::uint32_t cy = tile.cy0; cy < tile.cy1; ++cy)
-      for (std::size_t i = g.col_start[cx * g.ny + cy]; i < g.col_start[cx * g.ny + cy + 1]; ++i) {
+  std::vector<column_ref> near;
+  for (std::uint32_t tc = 0; tc < tile.count; ++tc) {
+    const std::uint32_t own = tile.cols[tc];
+    columns_after(g, static_cast<std::uint32_t>(g.col_key[own] >> 32), static_cast<std::uint32_t>(g.col_key[own]), span,
+                  near);
+      for (std::size_t i = g.col_start[own]; i < g.col_start[own + 1]; ++i) {
         const double xi = px_all[i], yi = py_all[i], zi = pz_all[i], ci = pc_all[i];
         V acc_n[LC][G] = {}, acc_d[LC][G] = {}, w[LC][G];  // index s: σ number L − 1 − s
-        for (std::uint32_t ax = cx; ax <= std::min(cx + span, g.nx - 1); ++ax)
-          for (std::uint32_t ay = ax == cx ? cy : (cy > span ? cy - span : 0); ay <= std::min(cy + span, g.ny - 1); ++ay) {
-            const std::uint32_t q = ax * g.ny + ay;
-            if (g.col_start[q] == g.col_start[q + 1]) continue;
+        for (const column_ref& nb : near) {
+            const std::size_t q = nb.q;
+            const std::uint32_t ax = nb.ax, ay = nb.ay;
             const double lx = g.x0 + ax * g.h, ly = g.y0 + ay * g.h;
             const double gx = std::max({0.0, lx - xi, xi - (lx + g.h)}), gy = std::max({0.0, ly - yi, yi - (ly + g.h)});
             const double dxy2 = gx * gx + gy * gy;
@@ -453,7 +483,7 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
             const double* zb = pz_all + g.col_start[q];
             const double* ze = pz_all + g.col_start[q + 1];
             const std::size_t j1 = static_cast<std::size_t>(std::upper_bound(zb, ze, zi + half) - pz_all);
-            const std::size_t j0 = ax == cx && ay == cy ? i + 1  // own column: the points above i
+            const std::size_t j0 = q == own ? i + 1  // own column: the points above i
                                    : static_cast<std::size_t>(std::lower_bound(zb, ze, zi - half) - pz_all);
             // Blocks start at multiples of 8, so that j's sums are whole aligned vectors.
             for (std::size_t j = j0 / block_lanes * block_lanes; j < j1; j += block_lanes) {
@@ -528,6 +558,7 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
           ni[block_lanes] += d[0] + 1.0;
         }
       }
+  }
 }
 
 // One tile with vectors V, 8 or 32 σ slots.
@@ -565,6 +596,32 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
 #pragma GCC diagnostic pop
 #endif
 
+// The tiles of span × span column positions that hold points, each with its phase
+// (tile x mod 2) · 3 + (tile y mod 3); cols receives the tiles' column lists. O(C log C) for C
+// occupied columns.
+inline std::vector<std::pair<std::uint32_t, column_tile>> make_column_tiles(const column_grid& g, std::uint32_t span,
+                                                                            std::vector<std::uint32_t>& cols) {
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> by_tile(g.col_key.size());
+  for (std::size_t q = 0; q < by_tile.size(); ++q) {
+    const auto cx = static_cast<std::uint32_t>(g.col_key[q] >> 32), cy = static_cast<std::uint32_t>(g.col_key[q]);
+    by_tile[q] = {column_grid::key(cx / span, cy / span), static_cast<std::uint32_t>(q)};
+  }
+  std::sort(by_tile.begin(), by_tile.end());  // by tile, then column index: (cx, cy) order
+  cols.resize(by_tile.size());
+  for (std::size_t k = 0; k < by_tile.size(); ++k) cols[k] = by_tile[k].second;
+  std::vector<std::pair<std::uint32_t, column_tile>> tiles;
+  for (std::size_t b = 0; b < by_tile.size();) {
+    std::size_t e = b;
+    std::uint32_t points = 0;
+    for (; e < by_tile.size() && by_tile[e].first == by_tile[b].first; ++e)
+      points += g.col_start[cols[e] + 1] - g.col_start[cols[e]];
+    const auto tx = static_cast<std::uint32_t>(by_tile[b].first >> 32), ty = static_cast<std::uint32_t>(by_tile[b].first);
+    tiles.push_back({tx % 2 * 3 + ty % 3, column_tile{cols.data() + b, static_cast<std::uint32_t>(e - b), points}});
+    b = e;
+  }
+  return tiles;
+}
+
 // Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
 // points. Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
 // tiles of span × span columns in 6 phases by (tile x mod 2, tile y mod 3): the tiles of one
@@ -587,16 +644,14 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
 #endif
   // Tiles of span × span columns: a tile writes its own columns and those up to span later in x,
   // span either side in y, so tiles 2 apart in x or 3 apart in y never write the same point.
-  const std::uint32_t ntx = (g.nx + span - 1) / span, nty = (g.ny + span - 1) / span;
+  // Phase (tile x mod 2, tile y mod 3).
+  std::vector<std::uint32_t> tile_cols;
+  const std::vector<std::pair<std::uint32_t, column_tile>> all_tiles = make_column_tiles(g, span, tile_cols);
   std::vector<column_tile> tiles;
   for (std::uint32_t phase = 0; phase < 6; ++phase) {
     tiles.clear();
-    for (std::uint32_t tx = phase / 3; tx < ntx; tx += 2)
-      for (std::uint32_t ty = phase % 3; ty < nty; ty += 3) {
-        column_tile c{tx * span, std::min((tx + 1) * span, g.nx), ty * span, std::min((ty + 1) * span, g.ny), 0};
-        for (std::uint32_t x = c.cx0; x < c.cx1; ++x) c.points += g.col_start[x * g.ny + c.cy1] - g.col_start[x * g.ny + c.cy0];
-        if (c.points) tiles.push_back(c);
-      }
+    for (const auto& [tile_phase, tile] : all_tiles)
+      if (tile_phase == phase) tiles.push_back(tile);
     // Largest first balances the workers; the order within a phase does not change any result.
     std::stable_sort(tiles.begin(), tiles.end(), [](const column_tile& a, const column_tile& b) { return a.points > b.points; });
     exec.parallel_for(tiles.size(), std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
