@@ -133,6 +133,43 @@ TEST_CASE("textured glTF 2.0 written and loaded back", "[assets]") {
   check_round_trip(a, *parts);
 }
 
+TEST_CASE("textured GLB (images embedded) written and loaded back", "[assets]") {
+  const auto a = small_asset();
+  const auto dir = scratch("glb");
+  const auto path = support::write_glb(a, dir, "asset");
+  INFO(why(path));
+  REQUIRE(path);
+  for (unsigned k = 0; k < a.materials; ++k) fs::remove(dir / ("asset_" + std::to_string(k) + ".png"));  // only the embedded copies
+  const auto parts = support::load_textured_mesh(*path);
+  INFO(why(parts));
+  REQUIRE(parts);
+  check_round_trip(a, *parts);
+}
+
+TEST_CASE("textured PLY written and loaded back: texcoords and the TextureFile comment", "[assets]") {
+  const auto a = small_asset();
+  const auto path = support::write_ply(a, scratch("ply"), "asset");
+  INFO(why(path));
+  REQUIRE(path);
+  const auto parts = support::load_textured_mesh(*path);
+  INFO(why(parts));
+  REQUIRE(parts);
+  REQUIRE(parts->size() == 1);
+  const auto& m = (*parts)[0].mesh;
+  REQUIRE(m.triangle_count() == a.mesh.triangle_count());
+  REQUIRE(m.has_texcoords());
+  std::size_t mismatch = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t)
+    for (unsigned c = 0; c < 3; ++c) {
+      const int k = static_cast<int>(c);
+      mismatch += m.positions[m.triangles[t][k]] != a.mesh.positions[a.mesh.triangles[t][k]] ? 1u : 0u;
+      mismatch += glm::distance(m.texcoord(t, c), a.mesh.texcoord(t, c)) > 1e-6f ? 1u : 0u;
+    }
+  CHECK(mismatch == 0);
+  REQUIRE((*parts)[0].image != nullptr);
+  CHECK((*parts)[0].image->width() == a.textures[0].width);
+}
+
 TEST_CASE("the generated asset: over 50k triangles, six charts, three materials", "[assets]") {
   const auto a = support::make_textured_asset();
   CHECK(a.mesh.triangle_count() >= 50000);

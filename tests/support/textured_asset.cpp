@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <array>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <glm/geometric.hpp>
 
 namespace infolerp::support {
@@ -157,12 +159,18 @@ result<std::string> write_obj(const textured_asset& a, const std::filesystem::pa
   return obj.string();
 }
 
-result<std::string> write_gltf(const textured_asset& a, const std::filesystem::path& dir, const std::string& name) {
-  const auto gltf = dir / (name + ".gltf"), bin = dir / (name + ".bin");
-  std::vector<float> data;  // per material: positions, normals, texcoords of its corners
+namespace {
+
+// The glTF document of `a` with its binary buffer in `bin`: per material, positions, normals and
+// texcoords of its corners. Images are the PNG files DIR/NAME_K.png, referenced by file name, or
+// (embed, for GLB) copied into the buffer after the geometry.
+result<std::string> gltf_json(const textured_asset& a, const std::filesystem::path& dir, const std::string& name, bool embed,
+                              std::vector<unsigned char>& bin) {
+  std::vector<float> data;
   std::string accessors, views, primitives;
+  std::size_t view_count = 0;
   auto add_view = [&](std::size_t offset, std::size_t bytes) {
-    if (!views.empty()) views += ",";
+    views += (view_count++ == 0 ? "" : ",");
     views += "{\"buffer\":0,\"byteOffset\":" + std::to_string(offset) + ",\"byteLength\":" + std::to_string(bytes) + "}";
   };
   std::size_t accessor = 0;
@@ -207,6 +215,8 @@ result<std::string> write_gltf(const textured_asset& a, const std::filesystem::p
                   ",\"TEXCOORD_0\":" + std::to_string(accessor + 2) + "},\"material\":" + std::to_string(k) + "}";
     accessor += 3;
   }
+  bin.resize(4 * data.size());
+  std::memcpy(bin.data(), data.data(), bin.size());
   std::string materials, textures, images;
   for (unsigned k = 0; k < a.materials; ++k) {
     const std::string sep = k == 0 ? "" : ",";
@@ -214,22 +224,84 @@ result<std::string> write_gltf(const textured_asset& a, const std::filesystem::p
                  "\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":" + std::to_string(k) +
                  "},\"metallicFactor\":0,\"roughnessFactor\":1}}";
     textures += sep + "{\"source\":" + std::to_string(k) + ",\"sampler\":0}";
-    images += sep + "{\"uri\":\"" + png_name(name, k) + "\"}";
+    if (!embed) {
+      images += sep + "{\"uri\":\"" + png_name(name, k) + "\"}";
+      continue;
+    }
+    const auto png = dir / png_name(name, k);
+    std::ifstream in(png, std::ios::binary);
+    const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.empty()) return make_error(errc::bad_parameter, no_element, "cannot read '", png.string(), "'");
+    images += sep + "{\"bufferView\":" + std::to_string(view_count) + ",\"mimeType\":\"image/png\"}";
+    add_view(bin.size(), bytes.size());
+    bin.insert(bin.end(), bytes.begin(), bytes.end());
+    bin.resize((bin.size() + 3) / 4 * 4, 0);
   }
-  {
-    std::ofstream out(bin, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(4 * data.size()));
-    if (!out) return make_error(errc::bad_parameter, no_element, "cannot write '", bin.string(), "'");
-  }
-  std::ofstream out(gltf);
-  out << "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
-      << "\"meshes\":[{\"primitives\":[" << primitives << "]}],\"materials\":[" << materials << "],\"textures\":["
-      << textures << "],\"samplers\":[{\"wrapS\":10497,\"wrapT\":10497}],\"images\":[" << images << "],"
-      << "\"accessors\":[" << accessors << "],\"bufferViews\":[" << views << "],\"buffers\":[{\"uri\":\"" << name
-      << ".bin\",\"byteLength\":" << 4 * data.size() << "}]}\n";
-  if (!out) return make_error(errc::bad_parameter, no_element, "cannot write '", gltf.string(), "'");
+  const std::string buffer = embed ? "{\"byteLength\":" + std::to_string(bin.size()) + "}"
+                                   : "{\"uri\":\"" + name + ".bin\",\"byteLength\":" + std::to_string(bin.size()) + "}";
+  return "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+         "\"meshes\":[{\"primitives\":[" + primitives + "]}],\"materials\":[" + materials + "],\"textures\":[" + textures +
+         "],\"samplers\":[{\"wrapS\":10497,\"wrapT\":10497}],\"images\":[" + images + "],\"accessors\":[" + accessors +
+         "],\"bufferViews\":[" + views + "],\"buffers\":[" + buffer + "]}";
+}
+
+}  // namespace
+
+result<std::string> write_gltf(const textured_asset& a, const std::filesystem::path& dir, const std::string& name) {
+  const auto gltf = dir / (name + ".gltf"), bin_path = dir / (name + ".bin");
   if (auto s = write_textures(a, dir, name); !s) return s;
+  std::vector<unsigned char> bin;
+  auto json = gltf_json(a, dir, name, false, bin);
+  if (!json) return json.error();
+  std::ofstream b(bin_path, std::ios::binary);
+  b.write(reinterpret_cast<const char*>(bin.data()), static_cast<std::streamsize>(bin.size()));
+  if (!b) return make_error(errc::bad_parameter, no_element, "cannot write '", bin_path.string(), "'");
+  std::ofstream out(gltf);
+  out << *json << "\n";
+  if (!out) return make_error(errc::bad_parameter, no_element, "cannot write '", gltf.string(), "'");
   return gltf.string();
+}
+
+result<std::string> write_ply(const textured_asset& a, const std::filesystem::path& dir, const std::string& name) {
+  const auto ply = dir / (name + ".ply");
+  if (auto s = write_textures(a, dir, name); !s) return s;
+  // Each vertex belongs to one chart's grid, so one texcoord per vertex holds every corner's.
+  std::vector<glm::vec2> uv(a.mesh.positions.size());
+  for (std::size_t t = 0; t < a.mesh.triangles.size(); ++t)
+    for (unsigned c = 0; c < 3; ++c) uv[a.mesh.triangles[t][static_cast<int>(c)]] = a.mesh.texcoord(t, c);
+  std::FILE* f = std::fopen(ply.string().c_str(), "w");
+  if (f == nullptr) return make_error(errc::bad_parameter, no_element, "cannot write '", ply.string(), "'");
+  std::fprintf(f, "ply\nformat ascii 1.0\ncomment TextureFile %s\nelement vertex %zu\nproperty float x\nproperty float y\n"
+               "property float z\nproperty float s\nproperty float t\nelement face %zu\nproperty list uchar int vertex_indices\nend_header\n",
+               png_name(name, 0).c_str(), a.mesh.positions.size(), a.mesh.triangles.size());
+  for (std::size_t v = 0; v < uv.size(); ++v) {
+    const glm::vec3 p = a.mesh.positions[v];
+    std::fprintf(f, "%.9g %.9g %.9g %.9g %.9g\n", double{p.x}, double{p.y}, double{p.z}, double{uv[v].x}, double{uv[v].y});
+  }
+  for (const glm::uvec3& t : a.mesh.triangles) std::fprintf(f, "3 %u %u %u\n", t.x, t.y, t.z);
+  if (std::fclose(f) != 0) return make_error(errc::bad_parameter, no_element, "cannot write '", ply.string(), "'");
+  return ply.string();
+}
+
+result<std::string> write_glb(const textured_asset& a, const std::filesystem::path& dir, const std::string& name) {
+  const auto glb = dir / (name + ".glb");
+  if (auto s = write_textures(a, dir, name); !s) return s;
+  std::vector<unsigned char> bin;
+  auto json = gltf_json(a, dir, name, true, bin);
+  if (!json) return json.error();
+  json->resize((json->size() + 3) / 4 * 4, ' ');
+  // Header (magic "glTF", version 2, total length), then the JSON and BIN chunks.
+  const auto u32 = [](std::size_t v) { return static_cast<std::uint32_t>(v); };
+  const std::uint32_t header[3] = {0x46546C67u, 2u, u32(12 + 8 + json->size() + 8 + bin.size())};
+  const std::uint32_t json_chunk[2] = {u32(json->size()), 0x4E4F534Au}, bin_chunk[2] = {u32(bin.size()), 0x004E4942u};
+  std::ofstream out(glb, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(header), sizeof header);
+  out.write(reinterpret_cast<const char*>(json_chunk), sizeof json_chunk);
+  out.write(json->data(), static_cast<std::streamsize>(json->size()));
+  out.write(reinterpret_cast<const char*>(bin_chunk), sizeof bin_chunk);
+  out.write(reinterpret_cast<const char*>(bin.data()), static_cast<std::streamsize>(bin.size()));
+  if (!out) return make_error(errc::bad_parameter, no_element, "cannot write '", glb.string(), "'");
+  return glb.string();
 }
 
 }  // namespace infolerp::support

@@ -1,6 +1,6 @@
 #pragma once
-// A generated textured asset, written to disk as OBJ + MTL + PNG or glTF 2.0 (+ .bin + PNG) for
-// tests and benchmarks that load real files (support/mesh_io.hpp):
+// A generated textured asset, written to disk as OBJ + MTL + PNG, glTF 2.0 (+ .bin + PNG), GLB or
+// PLY for tests and benchmarks that load real files (support/mesh_io.hpp):
 //   a bumpy sphere made of the six faces of a cube (cells x cells quads each, split in two
 //   triangles), each face its own texture chart: chart f is a padded tile of the atlas of
 //   material f % materials (tile f / materials of ceil(6 / materials) side by side). Charts
@@ -45,5 +45,10 @@ result<std::string> write_obj(const textured_asset& asset, const std::filesystem
 // DIR/NAME.gltf, DIR/NAME.bin and the same PNGs; one primitive per material (the same order),
 // unindexed corners. Returns the .gltf's path. Errors: as write_obj.
 result<std::string> write_gltf(const textured_asset& asset, const std::filesystem::path& dir, const std::string& name);
+// DIR/NAME.ply (ASCII; per-vertex texcoords s, t; "comment TextureFile NAME_0.png"): PLY has
+// no materials, so the whole mesh takes material 0's texture. Returns its path.
+result<std::string> write_ply(const textured_asset& asset, const std::filesystem::path& dir, const std::string& name);
+// DIR/NAME.glb: the same document as one binary file, the PNGs embedded. Returns its path.
+result<std::string> write_glb(const textured_asset& asset, const std::filesystem::path& dir, const std::string& name);
 
 }  // namespace infolerp::support

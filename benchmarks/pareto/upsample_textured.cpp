@@ -1,0 +1,304 @@
+// infolerp_pareto upsample --textured DIR [--size W H] [--repeat N] [--threads N] [--ao N] [--soft N]
+//                                         [--pictures OUT]
+//
+// The I-Buffer with the library's ready sample source (upsample/ray_cast_source.hpp) on a
+// textured asset loaded from disk, against per-pixel evaluation with the same source, in one
+// run. The asset is the tests' generator's (support/textured_asset.hpp: 52,272 triangles, six
+// charts, three materials with 512² textures), written to DIR as OBJ + MTL + PNG and loaded
+// back into the demo scene (support/demo_scene.hpp; image textures, trilinear mip lookup); the
+// built-in scene alone gives the second set of rows. Clusters: the demo's feature clustering
+// cut at UV seams (cluster/uv_seams.hpp). Every repetition renders each row once, in the same
+// order (interleaved), so the rows share the machine's load; times are the min and the median
+// over the repetitions (wall time, all threads). Rows:
+//   per_pixel        every pixel evaluated and shaded by the ready source (the reference image)
+//   per_pixel_hand   the same with the hand-written demo source (support/demo_upsample.hpp)
+//   ibuffer          the ready source, K passes
+//   ibuffer_refine   the ready source with refined probes (primary ray per pixel, hard shadow where
+//                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1
+//   *_hand           the hand-written source in the same setting (the ready source's cost ratio)
+// PSNR (display values) and SSIM (display luma) are against per_pixel's image. With --pictures,
+// OUT/reference.png, OUT/ibuffer.png (the fastest row with >= 40 dB and SSIM >= 0.98, else the
+// best PSNR) and OUT/clusters.png (cluster ids, boundaries dark, texture-chart seams white),
+// cropped to the asset.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+#include <omp.h>
+#include "infolerp/upsample/upsampler.hpp"
+#include "pareto.hpp"
+#include "support/demo_clusters.hpp"
+#include "support/demo_scene.hpp"
+#include "support/demo_upsample.hpp"
+#include "support/image.hpp"
+#include "support/reference_shader.hpp"
+#include "support/ssim.hpp"
+#include "support/textured_asset.hpp"
+
+namespace {
+
+namespace sup = infolerp::support;
+using sample = sup::demo_sample;
+
+struct textured_options {
+  std::filesystem::path dir, pictures;
+  int width = 1025, height = 1025, repeat = 5, threads = 0, ao = 64, soft = 16;
+};
+
+// One row: renders a frame into img, returns its evaluated fraction.
+struct row {
+  std::string method, setting;
+  std::function<double(sup::image&)> render;
+  std::vector<double> seconds;
+  double evaluated = 1.0, psnr = 0.0, ssim = 0.0;
+  sup::image img{};
+  double min() const { return *std::min_element(seconds.begin(), seconds.end()); }
+  double median() const {
+    auto s = seconds;
+    std::sort(s.begin(), s.end());
+    return s.size() % 2 == 1 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2 - 1] + s[s.size() / 2]);
+  }
+};
+
+template <class Source>
+std::function<double(sup::image&)> per_pixel(const Source& src, int threads) {
+  return [&src, threads](sup::image& img) {
+    const int w = img.width;
+    infolerp::openmp_executor{threads}.parallel_for(static_cast<std::size_t>(img.height), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t y = b; y < e; ++y)
+        for (int x = 0; x < w; ++x) {
+          const auto ux = static_cast<std::uint32_t>(x), uy = static_cast<std::uint32_t>(y);
+          img.at(x, static_cast<int>(y)) = src.shade(src.evaluate(ux, uy), ux, uy);
+        }
+    });
+    return 1.0;
+  };
+}
+
+template <class Source>
+std::function<double(sup::image&)> ibuffer(const Source& src, std::uint32_t passes, std::uint32_t min_sources, int threads, int w, int h) {
+  auto up = infolerp::upsampler<sample>::create(static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h),
+                                                {.passes = passes, .max_passes = passes, .rows_per_task = 2,
+                                                 .record_kinds = false, .min_sources = min_sources});
+  if (!up) {
+    std::fprintf(stderr, "infolerp_pareto upsample: %s\n", up.error().message().c_str());
+    std::exit(1);
+  }
+  auto shared = std::make_shared<infolerp::upsampler<sample>>(std::move(*up));
+  return [shared, &src, threads](sup::image& img) {
+    if (auto s = shared->render(src, std::span<glm::vec3>(img.pixels), infolerp::openmp_executor{threads}); !s) {
+      std::fprintf(stderr, "infolerp_pareto upsample: %s\n", s.message().c_str());
+      std::exit(1);
+    }
+    return shared->stats().evaluated_fraction();
+  };
+}
+
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+std::vector<float> luma(const sup::image& img) {
+  std::vector<float> l(img.pixels.size());
+  for (std::size_t i = 0; i < l.size(); ++i) l[i] = sup::display_luma(img.pixels[i]);
+  return l;
+}
+
+// Runs every row `repeat` times interleaved, then scores each against rows[0]'s image.
+void measure(std::vector<row>& rows, int repeat, int w, int h) {
+  for (auto& r : rows) r.img = sup::image(w, h);
+  for (int rep = 0; rep < repeat; ++rep)
+    for (auto& r : rows) {
+      const double t0 = now();
+      r.evaluated = r.render(r.img);
+      r.seconds.push_back(now() - t0);
+    }
+  const auto ref_luma = luma(rows[0].img);
+  for (auto& r : rows) {
+    r.psnr = *sup::psnr(rows[0].img, r.img);
+    r.ssim = *sup::ssim(ref_luma, luma(r.img), w, h);
+  }
+}
+
+void print(const std::string& scene, const std::vector<row>& rows) {
+  std::printf("\n%s\n%-16s %-34s %9s %9s %8s %8s %8s %8s %8s\n", scene.c_str(), "method", "setting", "min s", "median s",
+              "x(min)", "x(med)", "eval", "PSNR", "SSIM");
+  for (const auto& r : rows)
+    std::printf("%-16s %-34s %9.3f %9.3f %8.2f %8.2f %8.4f %8.2f %8.5f\n", r.method.c_str(), r.setting.c_str(), r.min(),
+                r.median(), rows[0].min() / r.min(), rows[0].median() / r.median(), r.evaluated, std::min(r.psnr, 99.0), r.ssim);
+  // The ready source against the hand-written one, per frame, in each setting they share.
+  for (const auto& hand : rows) {
+    if (!hand.method.ends_with("_hand")) continue;
+    for (const auto& ready : rows)
+      if (ready.method + "_hand" == hand.method && ready.setting == hand.setting)
+        std::printf("ready / hand-written, %s %s: %.3f (min) %.3f (median)\n", ready.method.c_str(), ready.setting.c_str(),
+                    ready.min() / hand.min(), ready.median() / hand.median());
+  }
+  std::fflush(stdout);
+}
+
+glm::vec3 id_colour(std::uint32_t k) {
+  std::uint32_t x = k * 0x9e3779b9u;
+  x ^= x >> 15;
+  x *= 0x85ebca6bu;
+  x ^= x >> 13;
+  return {0.25f + 0.7f * static_cast<float>(x & 255u) / 255.0f, 0.25f + 0.7f * static_cast<float>((x >> 8) & 255u) / 255.0f,
+          0.25f + 0.7f * static_cast<float>((x >> 16) & 255u) / 255.0f};
+}
+
+// The crop [x0, x1) x [y0, y1) of img.
+sup::image crop(const sup::image& img, int x0, int y0, int x1, int y1) {
+  sup::image out(x1 - x0, y1 - y0);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) out.at(x - x0, y - y0) = img.at(x, y);
+  return out;
+}
+
+// reference.png, ibuffer.png and clusters.png of the asset (objects first.. of the scene).
+void write_pictures(const textured_options& o, const sup::demo_scene& scene, const sup::textured_asset& asset, std::uint32_t first,
+                    const sup::scene_clustering& clusters, const std::vector<row>& rows) {
+  const int w = o.width, h = o.height;
+  std::vector<std::uint32_t> id(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), infolerp::invalid_id), chart(id);
+  sup::image img(w, h);
+  int x0 = w, y0 = h, x1 = 0, y1 = 0;
+  const auto rays = scene.view.rays();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto r = rays(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, w, h);
+      const auto hh = scene.tracer.intersect(r);
+      if (!hh.valid()) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      const auto& m = scene.objects[hh.geometry].mesh;
+      id[i] = clusters.ids[hh.geometry][hh.triangle];
+      const glm::vec3 n = glm::normalize(glm::cross(m.positions[m.triangles[hh.triangle].y] - m.positions[m.triangles[hh.triangle].x],
+                                                    m.positions[m.triangles[hh.triangle].z] - m.positions[m.triangles[hh.triangle].x]));
+      img.at(x, y) = (0.35f + 0.65f * std::abs(glm::dot(n, r.direction))) * id_colour(id[i]);
+      if (hh.geometry < first) continue;
+      const float u = hh.barycentric.x, v = hh.barycentric.y;
+      const glm::vec2 uv = (1.0f - u - v) * m.texcoord(hh.triangle, 0) + u * m.texcoord(hh.triangle, 1) + v * m.texcoord(hh.triangle, 2);
+      chart[i] = asset.chart_at(uv, hh.geometry - first);
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x + 1), y1 = std::max(y1, y + 1);
+    }
+  for (int y = 0; y + 1 < h; ++y)
+    for (int x = 0; x + 1 < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      const std::size_t right = i + 1, down = i + static_cast<std::size_t>(w);
+      if (chart[i] != chart[right] || chart[i] != chart[down]) img.at(x, y) = glm::vec3(1.0f);
+      else if (id[i] != id[right] || id[i] != id[down]) img.at(x, y) *= 0.3f;
+    }
+  const int margin = 8;
+  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin), x1 = std::min(w, x1 + margin), y1 = std::min(h, y1 + margin);
+  const row* best = nullptr;
+  for (const auto& r : rows) {
+    if (r.method != "ibuffer" && r.method != "ibuffer_refine") continue;
+    const bool good = r.psnr >= 40.0 && r.ssim >= 0.98;
+    const bool best_good = best != nullptr && best->psnr >= 40.0 && best->ssim >= 0.98;
+    if (best == nullptr || (good && (!best_good || r.min() < best->min())) || (!good && !best_good && r.psnr > best->psnr)) best = &r;
+  }
+  std::filesystem::create_directories(o.pictures);
+  const auto save = [&](const sup::image& full, const char* name) {
+    const auto path = (o.pictures / name).string();
+    if (auto s = sup::write_png(crop(full, x0, y0, x1, y1), path); !s) std::fprintf(stderr, "%s\n", s.message().c_str());
+    else std::printf("wrote %s\n", path.c_str());
+  };
+  save(rows[0].img, "reference.png");
+  if (best != nullptr) {
+    std::printf("ibuffer.png: %s %s\n", best->method.c_str(), best->setting.c_str());
+    save(best->img, "ibuffer.png");
+  }
+  save(img, "clusters.png");
+}
+
+// The rows of one scene: per-pixel (ready, hand-written), the I-Buffer plain and with refined
+// probes (ready), and the hand-written source in two I-Buffer settings.
+int run_scene(const std::string& title, const sup::demo_scene& scene, const textured_options& o, const sup::textured_asset* asset,
+              std::uint32_t first) {
+  const double t0 = now();
+  auto clustered = sup::cluster_by_features(scene, infolerp::openmp_executor{o.threads});
+  if (!clustered) return std::fprintf(stderr, "%s\n", clustered.error().message().c_str()), 1;
+  auto split = sup::split_at_texture_seams(scene, *clustered);
+  if (!split) return std::fprintf(stderr, "%s\n", split.error().message().c_str()), 1;
+  const sup::scene_clustering& clusters = *split;
+  std::printf("%s: %zu clusters, %zu after the UV-seam split (%.1f s)\n", title.c_str(), clustered->count(), clusters.count(), now() - t0);
+  sup::shader_options so{.ao_rays = static_cast<unsigned>(o.ao), .soft_shadow_rays = static_cast<unsigned>(o.soft)};
+  so.pixel_angle = sup::pixel_angle(scene.view, o.height);
+  const sup::reference_shader shader(scene, so);
+  sup::shader_options po = so;
+  po.ao_rays = 0;
+  po.soft_shadow_rays = 0;
+  const sup::reference_shader primary_sun(scene, po);
+  po.hard_shadow = false;
+  const sup::reference_shader primary(scene, po);
+  auto ready = sup::make_demo_ray_cast_source(shader, clusters, o.width, o.height);
+  auto refine = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(shader, clusters, o.width, o.height);
+  if (!ready || !refine) return std::fprintf(stderr, "ray_cast_source failed\n"), 1;
+  const sup::demo_ibuffer_source hand{&shader, &clusters, o.width, o.height};
+  sup::demo_refining_probe_source hand_refine;
+  static_cast<sup::demo_ibuffer_source&>(hand_refine) = hand;
+  hand_refine.primary = &primary;
+  hand_refine.probe_lights = false;
+  hand_refine.primary_sun = &primary_sun;
+
+  std::vector<row> rows;
+  rows.push_back({"per_pixel", "every pixel evaluated", per_pixel(*ready, o.threads), {}});
+  rows.push_back({"per_pixel_hand", "every pixel evaluated", per_pixel(hand, o.threads), {}});
+  for (std::uint32_t p : {3u, 4u, 5u})
+    rows.push_back({"ibuffer", std::to_string(p) + " passes", ibuffer(*ready, p, 2, o.threads, o.width, o.height), {}});
+  for (std::uint32_t p : {4u, 5u, 6u})
+    rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src", ibuffer(*refine, p, 1, o.threads, o.width, o.height), {}});
+  rows.push_back({"ibuffer_hand", "4 passes", ibuffer(hand, 4, 2, o.threads, o.width, o.height), {}});
+  rows.push_back({"ibuffer_refine_hand", "5 passes, min 1 src", ibuffer(hand_refine, 5, 1, o.threads, o.width, o.height), {}});
+  measure(rows, o.repeat, o.width, o.height);
+  print(title, rows);
+  if (asset != nullptr && !o.pictures.empty()) write_pictures(o, scene, *asset, first, clusters, rows);
+  return 0;
+}
+
+}  // namespace
+
+int pareto_upsample_textured(int argc, char** argv) {
+  textured_options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const bool has1 = i + 1 < argc, has2 = i + 2 < argc;
+    auto num = [&](int k) { return std::atoi(argv[i + k]); };
+    if (a == "--textured" && has1) o.dir = argv[++i];
+    else if (a == "--pictures" && has1) o.pictures = argv[++i];
+    else if (a == "--size" && has2) o.width = num(1), o.height = num(2), i += 2;
+    else if (a == "--repeat" && has1) o.repeat = num(1), ++i;
+    else if (a == "--threads" && has1) o.threads = num(1), ++i;
+    else if (a == "--ao" && has1) o.ao = num(1), ++i;
+    else if (a == "--soft" && has1) o.soft = num(1), ++i;
+    else {
+      std::fprintf(stderr, "usage: infolerp_pareto upsample --textured DIR [--size W H] [--repeat N] [--threads N] [--ao N] [--soft N] [--pictures OUT]\n");
+      return 2;
+    }
+  }
+  if (o.width < 16 || o.height < 16 || o.repeat < 1 || o.ao < 0 || o.soft < 0 || o.threads < 0) {
+    std::fprintf(stderr, "infolerp_pareto upsample: --size needs W H >= 16, --repeat >= 1, counts >= 0\n");
+    return 2;
+  }
+  sup::enable_flush_to_zero();
+#pragma omp parallel num_threads(o.threads > 0 ? o.threads : omp_get_max_threads())
+  sup::enable_flush_to_zero();
+  std::error_code ec;
+  std::filesystem::create_directories(o.dir, ec);
+  const auto asset = sup::make_textured_asset();
+  const auto path = sup::write_obj(asset, o.dir, "textured_asset");
+  if (!path) return std::fprintf(stderr, "infolerp_pareto upsample: %s\n", path.error().message().c_str()), 1;
+  std::printf("%dx%d, AO %d rays, soft shadow %d rays, threads %d, %d interleaved repetitions; asset %s (%zu triangles)\n",
+              o.width, o.height, o.ao, o.soft, o.threads > 0 ? o.threads : omp_get_max_threads(), o.repeat, path->c_str(),
+              asset.mesh.triangle_count());
+  const sup::embree_device device;
+  auto textured = sup::make_demo_scene(device, {.mesh_paths = {*path}, .mesh_size = 2.4f});
+  if (!textured) return std::fprintf(stderr, "infolerp_pareto upsample: %s\n", textured.error().message().c_str()), 1;
+  const std::uint32_t first = static_cast<std::uint32_t>(textured->objects.size()) - asset.materials;
+  if (int rc = run_scene("textured asset loaded from disk (+ built-in scene)", *textured, o, &asset, first); rc != 0) return rc;
+  auto builtin = sup::make_demo_scene(device);
+  if (!builtin) return std::fprintf(stderr, "infolerp_pareto upsample: %s\n", builtin.error().message().c_str()), 1;
+  return run_scene("built-in scene", *builtin, o, nullptr, 0);
+}
