@@ -1,8 +1,8 @@
 // infolerp_demo: renders the built-in demo scene (plus an optional --mesh) with the full
 // per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
-// saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png) and the
-// summary (a printed table, summary.csv, tradeoff.png). Any error gives one line on stderr and
-// a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
+// saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), the
+// view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,
+// tradeoff.png). Any error gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
 // an unwritable output directory).
 #include <charconv>
 #include <cstdio>
@@ -14,6 +14,7 @@
 #include <system_error>
 #include "demo.hpp"
 #include "stage_clusters.hpp"
+#include "stage_lod.hpp"
 #include "stage_saliency.hpp"
 #include "stage_summary.hpp"
 #include "stage_upsample.hpp"
@@ -190,6 +191,7 @@ int main(int argc, char** argv) {
   if (!demo::stage_clusters(ctx, clusters)) return 1;
   if (!demo::stage_saliency(ctx)) return 1;
   if (!demo::stage_upsample(ctx, &clusters)) return 1;
+  if (!demo::stage_lod(ctx)) return 1;
   if (!demo::stage_summary(ctx)) return 1;
   return 0;
 }

@@ -21,7 +21,18 @@ camera view_camera(unsigned k, unsigned n, const glm::dvec3& c, double r) {
   return {glm::vec3(c + dist * dir), glm::vec3(c), {0.0f, 0.0f, 1.0f}, static_cast<float>(fov)};
 }
 
+bounding_box box_of(std::span<const glm::vec3> positions) {
+  bounding_box box;
+  for (const glm::vec3& p : positions) box.extend(glm::dvec3(p));
+  return box;
+}
+
 }  // namespace
+
+camera mesh_view_camera(unsigned k, unsigned views, std::span<const glm::vec3> positions) {
+  const bounding_box box = box_of(positions);
+  return view_camera(k, views, box.center(), 0.5 * box.diagonal());
+}
 
 result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
                                              std::span<const std::uint32_t> indices, const mesh_view_options& opt) {
@@ -41,8 +52,7 @@ result<std::vector<image>> render_mesh_views(const embree_device& device, std::s
         return make_error(errc::index_out_of_range, t, "render_mesh_views: triangle ", t, " uses vertex ",
                           m.triangles[t][j], " of ", positions.size());
   }
-  bounding_box box;
-  for (const glm::vec3& p : positions) box.extend(glm::dvec3(p));
+  const bounding_box box = box_of(positions);
   const double r = 0.5 * box.diagonal();
   embree_scene tracer{device};
   if (auto id = tracer.add_mesh(m); !id) return id.error();

@@ -25,6 +25,10 @@ struct mesh_view_options {
   int threads = 0;  // render_reference's OpenMP threads (0: OpenMP's default)
 };
 
+// Camera k of `views` around the bounding box of `positions` (the one render_mesh_views uses;
+// view 0 is the same for any number of views).
+camera mesh_view_camera(unsigned k, unsigned views, std::span<const glm::vec3> positions);
+
 // One image per view. Errors: no triangles, an index out of range, sizes not positive.
 // Cost: views × width × height × (2 + soft + AO rays) rays plus one BVH build.
 result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
