@@ -1,15 +1,12 @@
 // Mesh saliency and salient clustering.
 // Goals: BM_Saliency_Exact on refined_elephant subdivided once 1:4 (~178k vertices) <= 1.0 s
-// wall on 2 cores; BM_Saliency_Approx <= 0.1 s at <= 1% relative L2 error against exact
-// (the time-against-error table: counters rel_l2_error and seconds, one row per
-// approx_cells_per_sigma setting);
+// wall on 2 cores;
 // BM_SalientClustering on bunny00 with C = 10 <= 0.5 s.
 // Figures: benchmarks/NOTES.md.
 // Google Benchmark's CPU column counts the main thread only: with 2 threads, compare wall times.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -27,16 +24,6 @@ const infolerp::indexed_mesh* elephant_subdivided() {
     return m.ok() ? std::optional(infolerp::support::subdivide_midpoint(*m)) : std::nullopt;
   }();
   return mesh ? &*mesh : nullptr;
-}
-
-const std::vector<double>* elephant_exact_saliency() {
-  static std::optional<std::vector<double>> s = []() -> std::optional<std::vector<double>> {
-    const auto* m = elephant_subdivided();
-    if (!m) return std::nullopt;
-    auto r = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{2});
-    return r.ok() ? std::optional(std::move(r->saliency)) : std::nullopt;
-  }();
-  return s ? &*s : nullptr;
 }
 
 void BM_Saliency_Exact(benchmark::State& state) {
@@ -80,32 +67,6 @@ void BM_Saliency_StrayVertex(benchmark::State& state) {
   state.counters["vertices"] = static_cast<double>(m.positions.size());
 }
 BENCHMARK(BM_Saliency_StrayVertex)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
-
-void BM_Saliency_Approx(benchmark::State& state) {
-  const auto* m = elephant_subdivided();
-  const auto* exact = elephant_exact_saliency();
-  if (!m || !exact) return state.SkipWithError("refined_elephant not found");
-  const infolerp::saliency_options opt{.method = infolerp::saliency_method::approximate,
-                                       .approx_cells_per_sigma = static_cast<double>(state.range(0)) / 4.0};
-  std::vector<double> last;
-  double seconds = 0.0;
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
-    auto s = infolerp::compute_saliency(*m, opt, infolerp::openmp_executor{2});
-    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!s.ok()) return state.SkipWithError(s.error().message().c_str());
-    last = std::move(s->saliency);
-  }
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i < last.size(); ++i) {
-    num += (last[i] - (*exact)[i]) * (last[i] - (*exact)[i]);
-    den += (*exact)[i] * (*exact)[i];
-  }
-  state.counters["cells_per_sigma"] = opt.approx_cells_per_sigma;
-  state.counters["rel_l2_error"] = std::sqrt(num / den);
-  state.counters["seconds"] = seconds;  // wall time of the last run (the time column of the table)
-}
-BENCHMARK(BM_Saliency_Approx)->DenseRange(4, 24, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -27,16 +27,16 @@ inline glm::vec3 heat_colour(float t) {
 // object its own mesh with coincident seam vertices welded, ε relative to its own bounding box),
 // written as DIR/saliency.png: the scene from the camera, coloured by saliency interpolated from
 // the vertices, one scale for the whole scene (square-root tone curve so mid values show).
-inline bool stage_saliency(const demo_context& ctx, saliency_method method = saliency_method::exact) {
+inline bool stage_saliency(const demo_context& ctx) {
   std::vector<std::vector<double>> values;  // per object, per original vertex
   double top = 0.0;
   for (const auto& object : ctx.scene.objects) {
     std::vector<std::uint32_t> remap;
     const indexed_mesh welded = support::weld_positions(object.mesh, remap);
 #ifdef _OPENMP
-    auto s = compute_saliency(welded, {.method = method}, openmp_executor{ctx.options.threads});
+    auto s = compute_saliency(welded, {}, openmp_executor{ctx.options.threads});
 #else
-    auto s = compute_saliency(welded, {.method = method});
+    auto s = compute_saliency(welded);
 #endif
     if (!s) {
       report(s.error());

@@ -1,7 +1,7 @@
-// libFuzzer target: curvature, mesh saliency (exact and approximate), salient clustering,
+// libFuzzer target: curvature, mesh saliency, salient clustering,
 // cluster attributes, cluster-localised saliency, view importance and budget distribution on
 // small fuzzed meshes with fuzzed options.
-// Input: [flags][epsilon][scale count][scales...][cells per sigma][clusters][seed][mesh][pool]
+// Input: [flags][epsilon][scale count][scales...][unused byte][clusters][seed][mesh][pool]
 // [iterations][camera][capacities...][target u16][lambda].
 #include <cmath>
 #include <numeric>
@@ -19,8 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   opt.epsilon = r.unit() * 0.2;  // up to 20% of the diagonal (NaN/negative/huge after a 255 marker)
   opt.scales.resize(r.u8() % 4);
   for (auto& s : opt.scales) s = 6.0 * r.unit();
-  opt.method = (flags & 1) ? infolerp::saliency_method::approximate : infolerp::saliency_method::exact;
-  opt.approx_cells_per_sigma = 0.25 + 4.0 * r.unit();
+  r.unit();  // unused: the seed corpus keeps its byte layout
   opt.grain = 1 + (flags >> 4);
   const std::uint32_t clusters = r.u8() % 10;
   const std::uint64_t seed = r.u8();

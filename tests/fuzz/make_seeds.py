@@ -55,13 +55,11 @@ write("fuzz_jensen_shannon", "subnormal_huge", bytes([7, 60]) + struct.pack("<H"
 write("fuzz_jensen_shannon", "mismatch", bytes([0, 127]) + struct.pack("<H", 3) + struct.pack("<H", 2) +
       bytes([64, 65, 66, 67, 68]))
 
-# fuzz_saliency: [flags][epsilon][scale count][scales][cells per sigma][clusters][seed][mesh][pool][iterations]
+# fuzz_saliency: [flags][epsilon][scale count][scales][unused][clusters][seed][mesh][pool][iterations]
 # [camera][capacities][target u16][lambda]
 sal_head = bytes([0, 64, 2, 85, 127, 180, 3, 1])
 write("fuzz_saliency", "icosahedron_exact", sal_head + mesh(ICO_V, ICO_T) + bytes([60, 4]) + c(3) + c(0) + c(0) +
       bytes([10] * 3) + struct.pack("<H", 20) + bytes([10]))
-write("fuzz_saliency", "icosahedron_approx", bytes([1]) + sal_head[1:] + mesh(ICO_V, ICO_T) + bytes([0, 2]) + c(0) +
-      c(4) + c(1) + bytes([3] * 3) + struct.pack("<H", 5) + bytes([127]))
 write("fuzz_saliency", "octahedron_one_scale", bytes([0, 40, 1, 127, 100, 2, 9]) + mesh(OCTA_V, OCTA_T) + bytes([254, 1]))
 
 # fuzz_subdivision: [flags][bisect][depth][mesh unless flags & 1] then operations

@@ -104,11 +104,11 @@ std::uint32_t add_vertex(indexed_mesh& m, glm::vec3 p) {
 
 // Mesh entry points, in the order of mesh_class::want.
 enum mesh_entry : std::size_t {
-  e_validate, e_topology, e_curvature, e_saliency_exact, e_saliency_approx, e_salient_clustering,
+  e_validate, e_topology, e_curvature, e_saliency, e_salient_clustering,
   e_cluster_attributes, e_cluster_localized, e_subdivision_build, e_cluster_mesh, mesh_entry_count
 };
 const char* const mesh_entry_names[mesh_entry_count] = {
-    "validate_mesh", "build_topology", "mean_curvature", "compute_saliency(exact)", "compute_saliency(approx)",
+    "validate_mesh", "build_topology", "mean_curvature", "compute_saliency",
     "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::build",
     "cluster_mesh(visibility+orientation+stretch)"};
 
@@ -125,7 +125,7 @@ struct mesh_class {
 mesh_class make_class(const char* name, indexed_mesh m, expect validate, expect topology, expect reads_positions,
                       expect saliency, expect build) {
   return {name, std::move(m),
-          {validate, topology, reads_positions, saliency, saliency, reads_positions, reads_positions, reads_positions,
+          {validate, topology, reads_positions, saliency, reads_positions, reads_positions, reads_positions,
            build, reads_positions}};
 }
 
@@ -251,11 +251,8 @@ std::pair<status, bool> run_mesh_entry(mesh_entry e, const indexed_mesh& m) {
       auto r = infolerp::mean_curvature(m);
       return {status_of(r), !r.ok() || (r->size() == nv && all_finite(*r))};
     }
-    case e_saliency_exact:
-    case e_saliency_approx: {
-      infolerp::saliency_options o;
-      o.method = e == e_saliency_exact ? infolerp::saliency_method::exact : infolerp::saliency_method::approximate;
-      auto r = infolerp::compute_saliency(m, o);
+    case e_saliency: {
+      auto r = infolerp::compute_saliency(m);
       return {status_of(r), !r.ok() || (r->saliency.size() == nv && all_finite(r->saliency) && all_finite(r->curvature))};
     }
     case e_salient_clustering: {
@@ -440,24 +437,11 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   check_cell("threshold below 0", "compute_saliency", sal({.scales = {-2.0}}), {errc::bad_parameter, "scale 0"});
   // A σ whose square underflows made the Gaussian weights of coincident vertices NaN (fuzzer).
   check_cell("parameter underflows", "compute_saliency", sal({.scales = {1e-160}}), {errc::bad_parameter, "saliency sigma"});
-  check_cell("parameter underflows", "compute_saliency(approx)",
-             sal({.scales = {1e-160}, .method = infolerp::saliency_method::approximate}), {errc::bad_parameter, "saliency sigma"});
   // A σ near 5e153 passed the σ² check, but the exact kernel's squared ball radius 4σ²
   // overflowed and the averages became NaN (fuzzer).
   const double huge_scale = 5e153 / (0.003 * infolerp::mesh_bounds(m).diagonal());
   check_cell("parameter overflows", "compute_saliency", sal({.scales = {2.0, huge_scale}}),
              {errc::bad_parameter, "saliency sigma"});
-  check_cell("threshold below 0", "compute_saliency(approx)",
-             sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = 0.1}),
-             {errc::bad_parameter, "approx_cells_per_sigma"});
-  // Inf cells per σ made the cell size 0 and its coordinates 0/0 = NaN (fuzzer).
-  check_cell("Inf parameter", "compute_saliency(approx)",
-             sal({.method = infolerp::saliency_method::approximate,
-                  .approx_cells_per_sigma = std::numeric_limits<double>::infinity()}),
-             {errc::bad_parameter, "approx_cells_per_sigma inf must be in [0.5, 1e6]"});
-  check_cell("NaN parameter", "compute_saliency(approx)",
-             sal({.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = nan_d}),
-             {errc::bad_parameter, "approx_cells_per_sigma"});
 
   std::vector<double> s(nv, 1.0);
   auto clus = [&](const std::vector<double>& v, infolerp::salient_clustering_options o) {

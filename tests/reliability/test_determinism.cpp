@@ -103,20 +103,17 @@ TEST_CASE("determinism: clustering (Algorithm 1, three channels) for 1, 2, 8 wor
   }
 }
 
-TEST_CASE("determinism: saliency (exact and approximate) for 1, 2, 8 workers", "[reliability][determinism][threads]") {
+TEST_CASE("determinism: saliency for 1, 2, 8 workers", "[reliability][determinism][threads]") {
   const indexed_mesh m = bumpy_sphere(3);
-  for (auto method : {infolerp::saliency_method::exact, infolerp::saliency_method::approximate}) {
-    INFO("method " << (method == infolerp::saliency_method::exact ? "exact" : "approximate"));
-    const auto outs = with_every_executor([&](auto exec) {
-      auto r = infolerp::compute_saliency(m, {.epsilon = 0.02, .method = method, .grain = 1}, exec);
-      REQUIRE(r.ok());
-      return *r;
-    });
-    for (const auto& o : outs) {
-      CHECK(same_bits(o.saliency, outs[0].saliency));
-      CHECK(same_bits(o.curvature, outs[0].curvature));
-      for (std::size_t i = 0; i < o.levels.size(); ++i) CHECK(same_bits(o.levels[i], outs[0].levels[i]));
-    }
+  const auto outs = with_every_executor([&](auto exec) {
+    auto r = infolerp::compute_saliency(m, {.epsilon = 0.02, .grain = 1}, exec);
+    REQUIRE(r.ok());
+    return *r;
+  });
+  for (const auto& o : outs) {
+    CHECK(same_bits(o.saliency, outs[0].saliency));
+    CHECK(same_bits(o.curvature, outs[0].curvature));
+    for (std::size_t i = 0; i < o.levels.size(); ++i) CHECK(same_bits(o.levels[i], outs[0].levels[i]));
   }
 }
 

@@ -99,12 +99,9 @@ TEST_CASE("stress: coordinates scaled by 1e30 and 1e-30", "[reliability][stress]
     for (std::size_t v = 0; v < h.size(); ++v) CHECK(std::abs(hs[v] * sd - h[v]) <= 1e-4 * max_abs(h));
 
     // Saliency is dimensionless: the same map at any scale (levels scale by 1/s).
-    for (auto method : {infolerp::saliency_method::exact, infolerp::saliency_method::approximate}) {
-      auto o = opt;
-      o.method = method;
-      INFO("method " << (method == infolerp::saliency_method::exact ? "exact" : "approximate"));
-      const auto ss = *infolerp::compute_saliency(ms, o);
-      const infolerp::mesh_saliency ref = method == infolerp::saliency_method::exact ? sal : *infolerp::compute_saliency(m, o);
+    {
+      const auto ss = *infolerp::compute_saliency(ms, opt);
+      const infolerp::mesh_saliency& ref = sal;
       REQUIRE(all_finite(ss.saliency));
       CHECK(ss.epsilon / sd == Approx(ref.epsilon).epsilon(1e-6));
       for (std::size_t i = 0; i < ss.levels.size(); ++i) {
@@ -212,8 +209,8 @@ TEST_CASE("stress: slivers with angles near 0 and 180 degrees", "[reliability][s
     const auto curv = infolerp::mean_curvature(m);
     REQUIRE(curv.ok());
     CHECK(all_finite(*curv));
-    for (auto method : {infolerp::saliency_method::exact, infolerp::saliency_method::approximate}) {
-      auto s = infolerp::compute_saliency(m, {.epsilon = 0.02, .method = method});
+    {
+      auto s = infolerp::compute_saliency(m, {.epsilon = 0.02});
       REQUIRE(s.ok());
       CHECK(all_finite(s->saliency));
       auto c = infolerp::salient_clustering(m, s->saliency, {.clusters = 3});

@@ -1,5 +1,5 @@
 // saliency/mesh_saliency.hpp: the fast path against an O(V²) reference, analytic shapes,
-// determinism across thread counts, the approximate mode's error, bad input.
+// determinism across thread counts, a far stray vertex, bad input.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -85,15 +85,6 @@ double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) 
   return d;
 }
 
-double relative_l2(const std::vector<double>& approx, const std::vector<double>& exact) {
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i < exact.size(); ++i) {
-    num += (approx[i] - exact[i]) * (approx[i] - exact[i]);
-    den += exact[i] * exact[i];
-  }
-  return std::sqrt(num / den);
-}
-
 }  // namespace
 
 TEST_CASE("saliency: fast exact path matches the O(V^2) definition to 1e-9") {
@@ -133,7 +124,7 @@ TEST_CASE("saliency: a far stray vertex leaves the neighbour grid as fine as the
 
   std::vector<double> curvature(m.positions.size(), 0.0);
   const auto used = infolerp::detail::referenced_vertices(m);
-  const auto points = infolerp::detail::referenced_point_grid(m, used, curvature, 1.0);
+  const auto points = infolerp::detail::referenced_points(m, used, curvature);
   const double width = 0.5 * s->epsilon;
   infolerp::serial_executor serial;
   const auto grid = infolerp::detail::make_column_grid(serial, points, width);
@@ -149,16 +140,9 @@ TEST_CASE("saliency: identical bits for any executor, thread count and grain") {
   for (unsigned workers : {2u, 3u, 4u})
     for (std::size_t grain : {std::size_t{1}, std::size_t{3}}) {
       opt.grain = grain;
-      for (auto method : {infolerp::saliency_method::exact, infolerp::saliency_method::approximate}) {
-        opt.method = method;
-        opt.grain = 1;
-        auto ref = infolerp::compute_saliency(m, opt);
-        opt.grain = grain;
-        auto par = infolerp::compute_saliency(m, opt, infolerp::support::thread_pool_executor{workers});
-        REQUIRE(par.ok());
-        CHECK(par->saliency == ref->saliency);
-      }
-      opt.method = infolerp::saliency_method::exact;
+      auto par = infolerp::compute_saliency(m, opt, infolerp::support::thread_pool_executor{workers});
+      REQUIRE(par.ok());
+      CHECK(par->saliency == serial->saliency);
     }
 }
 
@@ -189,24 +173,6 @@ TEST_CASE("saliency: a sphere is uniformly non-salient, bumps on a plane are sal
   INFO("mean saliency near the bump " << near / n_near << ", far " << far / n_far);
   CHECK(near / n_near > 100.0 * (far / n_far));
   CHECK(sphere_max < 1e-3 * *std::max_element(b->saliency.begin(), b->saliency.end()));
-}
-
-TEST_CASE("saliency: the approximate mode stays within 1% relative L2 of exact") {
-  // A bumpy sphere (many features at several scales), ~10k vertices.
-  auto m = infolerp::support::make_icosphere(5);
-  for (auto& p : m.positions) {
-    const float f = 1.0f + 0.03f * std::sin(9.0f * p.x) * std::sin(7.0f * p.y + 1.0f) * std::cos(5.0f * p.z);
-    p *= f;
-  }
-  infolerp::saliency_options opt{};
-  auto exact = infolerp::compute_saliency(m, opt);
-  REQUIRE(exact.ok());
-  opt.method = infolerp::saliency_method::approximate;
-  auto approx = infolerp::compute_saliency(m, opt);
-  REQUIRE(approx.ok());
-  const double err = relative_l2(approx->saliency, exact->saliency);
-  INFO("relative L2 error of the approximate saliency " << err);
-  CHECK(err <= 0.01);
 }
 
 TEST_CASE("saliency: bad input gets a clear status") {
@@ -245,19 +211,4 @@ TEST_CASE("saliency: bad input gets a clear status") {
   point.positions = {{1, 1, 1}};
   point.triangles = {{0, 0, 0}};
   CHECK(infolerp::compute_saliency(point).error().code() == infolerp::errc::degenerate_triangle);
-}
-
-TEST_CASE("saliency: approximate error table", "[.table]") {
-  auto m = infolerp::support::make_icosphere(5);
-  for (auto& p : m.positions) {
-    const float f = 1.0f + 0.03f * std::sin(9.0f * p.x) * std::sin(7.0f * p.y + 1.0f) * std::cos(5.0f * p.z);
-    p *= f;
-  }
-  auto exact = infolerp::compute_saliency(m);
-  for (double cps : {0.5, 1.0, 2.0, 3.0, 4.0, 6.0}) {
-    auto approx = infolerp::compute_saliency(m, {.method = infolerp::saliency_method::approximate, .approx_cells_per_sigma = cps});
-    double lv = 0;
-    for (std::size_t i = 0; i < 5; ++i) lv = std::max(lv, relative_l2(approx->levels[i], exact->levels[i]));
-    WARN("cells/sigma " << cps << " saliency rel L2 " << relative_l2(approx->saliency, exact->saliency) << " worst level " << lv);
-  }
 }

@@ -22,7 +22,7 @@
 //      with a strict comparison, two computations that agree to 1e-14 gave saliencies 1% apart);
 //   3. N(S_i) = scaled S_i · (M − m̄)².
 //
-// Exact mode: vertices are sorted into the columns of an xy grid (columns 2σ_max/3 wide), by z
+// Vertices are sorted into the columns of an xy grid (columns 2σ_max/3 wide), by z
 // inside a column, so the candidates of a vertex are, per nearby column, one contiguous z-run
 // (binary search). Each pair is evaluated once: a vertex meets the vertices after it in that
 // order (the rest of its own column's run, then the later columns), for all distinct σ (σ_i and
@@ -44,19 +44,7 @@
 // a plain 4-double struct. exp(−x) on [0, 2] (the only range the ball cutoff produces) is a
 // polynomial fit, relative error ~1e-16.
 // Measured times per kernel and what was tried instead: benchmarks/NOTES.md (BM_Saliency_Exact).
-//
-// Approximate mode (method = approximate): the ball sums are taken over cell representatives
-// instead of vertices. For each distinct σ the vertices are binned into cells of size
-// σ / approx_cells_per_sigma (sparse: sorted 63-bit cell keys); a representative sits at its
-// vertices' centroid and carries their count, curvature sum and RMS spread. Each vertex sums
-// exp(−d²/2σ²)·(count, sum C) over representatives near its ball; a representative straddling
-// the 2σ edge counts with a linear ramp over ±1.5 × its spread (a single vertex keeps the hard
-// cutoff), which removes most of the in/out error of whole cells.
-// Its error against exact is a few per cent on large meshes, where it is no faster than exact;
-// the hard 2σ edge keeps any smooth approximation from 1% (benchmarks/NOTES.md,
-// BM_Saliency_Approx).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -64,7 +52,6 @@
 #include <limits>
 #include <utility>
 #include <vector>
-#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/detail/cpu.hpp"
 #include "infolerp/core/executor.hpp"
@@ -76,18 +63,11 @@
 
 namespace infolerp {
 
-enum class saliency_method : std::uint8_t {
-  exact,        // every vertex pair within 2σ (matches the O(V²) definition to rounding)
-  approximate,  // cell representatives per σ (see the top of this file)
-};
-
 struct saliency_options {
   double epsilon = 0.003;                          // ε as a fraction of the bounding-box diagonal
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
-  saliency_method method = saliency_method::exact;  // exact or approximate
-  double approx_cells_per_sigma = 4.0;             // approximate mode: representative cells per σ, in [0.5, 1e6]
-  std::size_t grain = 1;                           // tiles of 3 × 3 columns (exact), ×256 vertices (approximate) per parallel task
+  std::size_t grain = 1;                           // tiles of 3 × 3 columns per parallel task
 };
 
 struct mesh_saliency {
@@ -119,70 +99,11 @@ INFOLERP_FORCE_INLINE void exp_neg_inplace(T& x) {
   x = q2 * q2;
 }
 
-// exp(x) for x in [−2, 0].
-inline double exp_neg2(double x) {
-  x = -x;
-  exp_neg_inplace(x);
-  return x;
-}
-
-// Points (x, y, z, value, weight) sorted by the cell of a uniform grid, cells at least
-// `min_cell` wide (wider when needed to keep the cell count O(points)).
-struct point_grid {
-  std::vector<double> x, y, z, value, weight;
-  std::vector<std::uint32_t> id;          // caller's id of each sorted point
-  std::vector<std::uint32_t> cell_start;  // cells + 1 offsets into the sorted points
-  glm::dvec3 lo{0.0};
-  double cell = 1.0;
-  std::array<std::uint32_t, 3> n{1, 1, 1};
-
-  std::uint32_t cell_index(std::uint32_t cx, std::uint32_t cy, std::uint32_t cz) const {
-    return (cx * n[1] + cy) * n[2] + cz;
-  }
-  std::uint32_t coord(double p, int axis) const {
-    const double f = std::floor((p - lo[axis]) / cell);
-    return f <= 0.0 ? 0u : static_cast<std::uint32_t>(std::min<double>(f, n[static_cast<std::size_t>(axis)] - 1));
-  }
+// The referenced vertices (those a triangle uses), in index order: position, value, index.
+struct vertex_points {
+  std::vector<double> x, y, z, value;
+  std::vector<std::uint32_t> id;
 };
-
-// Builds a point_grid over pts (positions), values, weights. Counting sort: O(P + cells).
-inline point_grid make_point_grid(const std::vector<glm::dvec3>& pts, const std::vector<double>& values,
-                                  const std::vector<double>& weights, const std::vector<std::uint32_t>& ids,
-                                  double min_cell) {
-  point_grid g;
-  bounding_box box;
-  for (const auto& p : pts) box.extend(p);
-  g.lo = box.empty() ? glm::dvec3(0.0) : box.lo;
-  const glm::dvec3 ext = box.empty() ? glm::dvec3(0.0) : box.hi - box.lo;
-  const double max_cells = 4.0 * static_cast<double>(pts.size()) + 64.0;
-  double h = min_cell > 0.0 ? min_cell : 1.0;
-  for (;;) {
-    double total = 1.0;
-    for (int a = 0; a < 3; ++a) total *= std::max(1.0, std::floor(ext[a] / h));
-    if (total <= max_cells) break;
-    h *= 1.25;
-  }
-  g.cell = h;
-  for (int a = 0; a < 3; ++a) g.n[static_cast<std::size_t>(a)] = static_cast<std::uint32_t>(std::max(1.0, std::floor(ext[a] / h)));
-  // Cells are floor(ext/h) wide in count, so the last one may be up to 2h wide: still >= h.
-  const std::size_t cells = std::size_t{g.n[0]} * g.n[1] * g.n[2];
-  std::vector<std::uint32_t> cell_of(pts.size());
-  g.cell_start.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    cell_of[i] = g.cell_index(g.coord(pts[i].x, 0), g.coord(pts[i].y, 1), g.coord(pts[i].z, 2));
-    ++g.cell_start[cell_of[i] + 1];
-  }
-  for (std::size_t c = 0; c < cells; ++c) g.cell_start[c + 1] += g.cell_start[c];
-  std::vector<std::uint32_t> cursor(g.cell_start.begin(), g.cell_start.end() - 1);
-  g.x.resize(pts.size()), g.y.resize(pts.size()), g.z.resize(pts.size());
-  g.value.resize(pts.size()), g.weight.resize(pts.size()), g.id.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const std::uint32_t k = cursor[cell_of[i]]++;
-    g.x[k] = pts[i].x, g.y[k] = pts[i].y, g.z[k] = pts[i].z;
-    g.value[k] = values[i], g.weight[k] = weights[i], g.id[k] = ids[i];
-  }
-  return g;
-}
 
 // used[v] = 1 when a triangle references vertex v. O(V + T), allocation O(V).
 template <class M>
@@ -195,21 +116,18 @@ std::vector<char> referenced_vertices(const M& m) {
   return used;
 }
 
-// A point_grid over the referenced vertices (value values[v], weight 1, id v). O(V + cells).
+// The vertices with used[v], value values[v]. O(V), allocation O(V).
 template <class M>
-point_grid referenced_point_grid(const M& m, const std::vector<char>& used, std::span<const double> values,
-                                 double min_cell) {
-  std::vector<glm::dvec3> pts;
-  std::vector<double> vals, ones;
-  std::vector<std::uint32_t> ids;
+vertex_points referenced_points(const M& m, const std::vector<char>& used, std::span<const double> values) {
+  vertex_points g;
   for (std::size_t v = 0; v < used.size(); ++v)
     if (used[v]) {
-      pts.push_back(glm::dvec3(mesh_position(m, v)));
-      vals.push_back(values[v]);
-      ids.push_back(static_cast<std::uint32_t>(v));
+      const glm::dvec3 p(mesh_position(m, v));
+      g.x.push_back(p.x), g.y.push_back(p.y), g.z.push_back(p.z);
+      g.value.push_back(values[v]);
+      g.id.push_back(static_cast<std::uint32_t>(v));
     }
-  ones.assign(pts.size(), 1.0);
-  return make_point_grid(pts, vals, ones, ids, min_cell);
+  return g;
 }
 
 inline constexpr std::size_t block_lanes = 8;  // candidates per block of the pair kernel
@@ -229,7 +147,7 @@ inline std::size_t aligned_offset(const std::vector<double>& v) {
 struct column_grid {
   std::vector<double> rows;               // sorted points: x, y, z, value rows (see row)
   std::size_t points = 0, stride = 0, offset = 0;
-  std::vector<std::uint32_t> src;         // index of each sorted point in the source point_grid
+  std::vector<std::uint32_t> src;         // index of each sorted point in the source vertex_points
   std::vector<std::uint64_t> col_key;     // occupied columns, ascending: cx << 32 | cy
   std::vector<std::uint32_t> col_start;   // occupied columns + 1 offsets into the sorted points
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
@@ -246,7 +164,7 @@ struct column_grid {
 // Builds a column_grid with columns `width` wide (wider only when a coordinate would pass 2^31
 // columns). O(P log P), allocation O(P); the columns are sorted in parallel through exec.
 template <class E>
-column_grid make_column_grid(E& exec, const point_grid& g, double width) {
+column_grid make_column_grid(E& exec, const vertex_points& g, double width) {
   column_grid c;
   const std::size_t P = g.x.size();
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
@@ -629,7 +547,7 @@ inline std::vector<std::pair<std::uint32_t, column_tile>> make_column_tiles(cons
 // an order fixed by the data: identical bits for any executor, thread count and grain (tiles
 // per task).
 template <class E>
-std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const std::vector<double>& sigma,
+std::vector<double> exact_gaussian_averages(E& exec, const vertex_points& pg, const std::vector<double>& sigma,
                                             std::size_t grain) {
   const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
@@ -681,105 +599,19 @@ std::vector<double> exact_gaussian_averages(E& exec, const point_grid& pg, const
   return avg;
 }
 
-// Approximate averages: per σ, representatives of cells σ/cells_per_sigma wide, gathered per
-// vertex over the representatives within 2σ. Parallel over vertices; deterministic.
-template <class E>
-std::vector<double> approximate_gaussian_averages(E& exec, const point_grid& g, const std::vector<double>& sigma,
-                                                  double cells_per_sigma, std::size_t grain) {
-  const std::size_t P = g.x.size(), L = sigma.size();
-  std::vector<double> avg(L * P);
-  std::vector<glm::dvec3> rep_pos;
-  std::vector<double> rep_sum, rep_count, rep_spread;
-  std::vector<std::uint32_t> rep_ids;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
-  for (std::size_t u = 0; u < L; ++u) {
-    // Representatives: bin the points into cells of size h (sparse: sort by 63-bit cell key).
-    const double h = sigma[u] / cells_per_sigma;
-    keyed.resize(P);
-    for (std::size_t k = 0; k < P; ++k) {
-      auto q = [&](double p, int axis) {
-        return static_cast<std::uint64_t>(std::min(std::floor((p - g.lo[axis]) / h), 2097151.0));
-      };
-      keyed[k] = {(q(g.x[k], 0) << 42) | (q(g.y[k], 1) << 21) | q(g.z[k], 2), static_cast<std::uint32_t>(k)};
-    }
-    std::sort(keyed.begin(), keyed.end());
-    rep_pos.clear(), rep_sum.clear(), rep_count.clear(), rep_ids.clear(), rep_spread.clear();
-    for (std::size_t b = 0; b < P;) {
-      std::size_t e = b;
-      glm::dvec3 s(0.0);
-      double cs = 0.0;
-      for (; e < P && keyed[e].first == keyed[b].first; ++e) {
-        const std::uint32_t k = keyed[e].second;
-        s += glm::dvec3(g.x[k], g.y[k], g.z[k]), cs += g.value[k];
-      }
-      const double cnt = static_cast<double>(e - b);
-      const glm::dvec3 centre = s / cnt;
-      double spread = 0.0;  // RMS distance of the cell's points to their centroid
-      for (std::size_t f = b; f < e; ++f) {
-        const std::uint32_t k = keyed[f].second;
-        const glm::dvec3 d = glm::dvec3(g.x[k], g.y[k], g.z[k]) - centre;
-        spread += glm::dot(d, d);
-      }
-      rep_pos.push_back(centre), rep_sum.push_back(cs), rep_count.push_back(cnt);
-      rep_spread.push_back(std::sqrt(spread / cnt));
-      rep_ids.push_back(static_cast<std::uint32_t>(rep_ids.size()));
-      b = e;
-    }
-    const point_grid reps = make_point_grid(rep_pos, rep_sum, rep_count, rep_ids, 2.0 * sigma[u] + 1.5 * h);
-    const double r2 = 4.0 * sigma[u] * sigma[u], a = 1.0 / (2.0 * sigma[u] * sigma[u]);
-    const double inner = std::max(0.0, 2.0 * sigma[u] - 1.5 * h), outer = 2.0 * sigma[u] + 1.5 * h;
-    const std::vector<double>& reps_spread = rep_spread;
-    const double inner2 = inner * inner, outer2 = outer * outer;
-    exec.parallel_for(P, 256 * std::max<std::size_t>(grain, 1), [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const double xi = g.x[k], yi = g.y[k], zi = g.z[k];
-        const std::uint32_t cx = reps.coord(xi, 0), cy = reps.coord(yi, 1), cz = reps.coord(zi, 2);
-        double num = 0.0, den = 0.0;
-        for (std::uint32_t ax = cx > 0 ? cx - 1 : 0; ax <= std::min(cx + 1, reps.n[0] - 1); ++ax)
-          for (std::uint32_t ay = cy > 0 ? cy - 1 : 0; ay <= std::min(cy + 1, reps.n[1] - 1); ++ay)
-            for (std::uint32_t az = cz > 0 ? cz - 1 : 0; az <= std::min(cz + 1, reps.n[2] - 1); ++az) {
-              const std::uint32_t c = reps.cell_index(ax, ay, az);
-              for (std::uint32_t j = reps.cell_start[c]; j < reps.cell_start[c + 1]; ++j) {
-                const double dx = reps.x[j] - xi, dy = reps.y[j] - yi, dz = reps.z[j] - zi;
-                const double d2 = dx * dx + dy * dy + dz * dz;
-                if (d2 > outer2) continue;
-                // Soft cutoff: a cell straddling the ball's edge counts with roughly the
-                // fraction of its points inside (a linear ramp of half-width 1.5 × its RMS
-                // spread around 2σ; a single point keeps the hard cutoff).
-                double w = exp_neg2(-std::min(d2, r2) * a);
-                if (d2 > inner2) {
-                  const double ramp = 1.5 * reps_spread[reps.id[j]];
-                  const double dist = std::sqrt(d2);
-                  if (ramp > 0.0)
-                    w *= std::clamp(0.5 + (2.0 * sigma[u] - dist) / (2.0 * ramp), 0.0, 1.0);
-                  else if (d2 > r2)
-                    continue;
-                }
-                num += w * reps.value[j];
-                den += w * reps.weight[j];
-              }
-            }
-        avg[u * P + k] = den > 0.0 ? num / den : g.value[k];
-      }
-    });
-  }
-  return avg;
-}
-
 }  // namespace detail
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
 // scales or more than 16 (counted as given, repeats included), a scale <= 0 or not finite,
-// flat_level_threshold negative or not finite, approx_cells_per_sigma outside [0.5, 1e6] (NaN, Inf), a σ
+// flat_level_threshold negative or not finite, a σ
 // (scale × epsilon × diagonal) below ~1.5e-154 or above ~3.3e153, where σ² underflows or 16σ²
 // overflows (bad_parameter); a
 // mesh whose bounding box has zero diagonal (degenerate_triangle).
-// Complexity, exact: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
-// unordered pairs within 2σ_max, each evaluated once); approximate: O(V·σs·k) with
-// k ~ (4·approx_cells_per_sigma)² representatives per ball. Allocation O(V·σs) (3 doubles per
-// vertex and distinct σ, 64 at most; never per pair). Parallel through exec (exact: 6 phases of
-// tiles); the result is identical for every executor and thread count.
+// Complexity: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the unordered
+// pairs within 2σ_max, each evaluated once). Allocation O(V·σs) (3 doubles per vertex and
+// distinct σ, 64 at most; never per pair). Parallel through exec (6 phases of tiles); the
+// result is identical for every executor and thread count.
 template <class M, class E = serial_executor>
 result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt = {}, E&& exec = E{}) {
   static_assert(check_mesh<M>());
@@ -796,12 +628,6 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
-  // Above 1e6 cells per σ (or Inf) the cell size σ / cells can underflow to 0, and 0/0 cell
-  // coordinates are NaN (found by fuzz_saliency); such a setting is meaningless anyway.
-  if (opt.method == saliency_method::approximate &&
-      !(opt.approx_cells_per_sigma >= 0.5 && opt.approx_cells_per_sigma <= 1e6))
-    return make_error(errc::bad_parameter, no_element, "approx_cells_per_sigma ", opt.approx_cells_per_sigma,
-                      " must be in [0.5, 1e6]");
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
@@ -836,12 +662,9 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
 
   // Referenced vertices only: an unused vertex has no curvature and must not dilute averages.
   const std::vector<char> used = detail::referenced_vertices(m);
-  const detail::point_grid grid = detail::referenced_point_grid(m, used, out.curvature, 2.0 * sigma.back());
+  const detail::vertex_points grid = detail::referenced_points(m, used, out.curvature);
   const std::size_t P = grid.x.size();
-  const std::vector<double> avg =
-      opt.method == saliency_method::exact
-          ? detail::exact_gaussian_averages(exec, grid, sigma, opt.grain)
-          : detail::approximate_gaussian_averages(exec, grid, sigma, opt.approx_cells_per_sigma, opt.grain);
+  const std::vector<double> avg = detail::exact_gaussian_averages(exec, grid, sigma, opt.grain);
 
   // Levels and Lee's normalisation.
   double mean_abs_c = 0.0;
