@@ -29,9 +29,12 @@
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
-//   merging      clusters with fewer than min_cluster_fraction·M elements join the neighbouring
+//   merging      clusters with fewer than min_cluster_fraction·N elements join the neighbouring
 //                cluster whose seed has the smallest JS to theirs (ties: smallest id), in passes
-//                (smallest first) until none can merge. Isolated small clusters stay.
+//                (smallest first) until none can merge. Isolated small clusters stay. N is
+//                fraction_of when set (cluster_mesh: the mesh's triangle count, the paper's "a
+//                given fraction of the input triangles", so the floor is the same for the small
+//                sets of later channels), else the set's own size M.
 //   numbering    clusters are numbered by their smallest element.
 // Every cluster is connected in the graph; results are identical for any executor.
 #include <algorithm>
@@ -82,6 +85,7 @@ struct region_growing_options {
   double threshold = 0.1;               // JS threshold Th in [0,1]
   double min_cluster_fraction = 0.001;  // §3.2.4: smaller clusters merge into a neighbour (0 = never)
   std::size_t grain = 32;               // classes per parallel task when evaluating JS columns
+  std::size_t fraction_of = 0;          // N of the merging floor fraction·N; 0 = the set's size
 };
 
 struct region_growing_result {
@@ -493,7 +497,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   }
 
   // §3.2.4 merging, in passes.
-  const double min_size = o.min_cluster_fraction * static_cast<double>(m);
+  const double min_size = o.min_cluster_fraction * static_cast<double>(o.fraction_of ? o.fraction_of : m);
   for (bool changed = true; changed && min_size > 1.0;) {
     changed = false;
     const std::size_t kc = r.seeds.size();
@@ -512,6 +516,10 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
       if (si == invalid_id) continue;
       for (std::uint32_t n : g.neighbours_of(e))
         if (label[n] != label[e]) adj[si].push_back(label[n]);
+    }
+    for (auto& a : adj) {  // one divergence per neighbouring cluster (the choice is order-free)
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
     }
     std::vector<std::uint32_t> parent(kc);
     std::iota(parent.begin(), parent.end(), 0u);
