@@ -260,6 +260,39 @@ TEST_CASE("a user channel (material ids) clusters by material", "[cluster]") {
   REQUIRE(r2->cluster_of == r->cluster_of);
 }
 
+TEST_CASE("small clusters merge below a fraction of the whole mesh, in every channel", "[cluster]") {
+  // 800 triangles; the first channel splits the plane into halves of 400, the second finds a
+  // patch of 10 triangles in each half. With fraction 0.02 the floor is 16 triangles (of the
+  // mesh), not 8 (of a half): the patches merge back, as when the second channel runs alone.
+  const auto m = support::make_plane(20, 20, 20.0f);
+  material_channel halves, patches;
+  std::size_t patch_size = 0;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto c = triangle_centroid(corners(m, t));
+    halves.material.push_back(c.x < 0.0f ? 0 : 1);
+    const bool patch = std::fabs(c.x) > 2.0f && std::fabs(c.x) < 7.0f && c.y * c.x > 0.0f && std::fabs(c.y) > 2.0f &&
+                       std::fabs(c.y) < 3.0f;
+    patches.material.push_back(patch ? (c.x < 0.0f ? 2 : 3) : 0);
+    patch_size += patch && c.x > 0.0f;
+  }
+  REQUIRE(patch_size == 10);
+  const test::brute_tracer tracer(m);
+  auto merged = cluster_mesh(m, tracer, serial, cluster_options{.min_cluster_fraction = 0.02}, halves, patches);
+  REQUIRE(merged.ok());
+  check_invariants(m, *merged);
+  CHECK(merged->channels[1].merged == 2);
+  CHECK(merged->cluster_count == 2);
+  auto alone = cluster_mesh(m, tracer, serial, cluster_options{.min_cluster_fraction = 0.02}, patches);
+  REQUIRE(alone.ok());
+  CHECK(alone->cluster_count == 1);
+  // Below a floor of 8 triangles (fraction 0.01 of the mesh) the patches stay in both orders.
+  auto kept = cluster_mesh(m, tracer, serial, cluster_options{.min_cluster_fraction = 0.01}, halves, patches);
+  REQUIRE(kept.ok());
+  check_invariants(m, *kept);
+  CHECK(kept->cluster_count == 4);
+  CHECK(cluster_mesh(m, tracer, serial, cluster_options{.min_cluster_fraction = 0.01}, patches)->cluster_count == 3);
+}
+
 TEST_CASE("bad input returns a clear status", "[cluster]") {
   auto m = support::make_icosphere(1);
   const test::brute_tracer tracer(m);

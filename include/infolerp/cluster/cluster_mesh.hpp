@@ -38,7 +38,9 @@
 namespace infolerp {
 
 struct cluster_options {
-  double min_cluster_fraction = 0.001;  // §3.2.4: clusters below this fraction of their set merge (0 = never)
+  // §3.2.4: clusters smaller than this fraction of the mesh's triangles merge into a neighbour,
+  // in every channel (the paper's "fraction of the input triangles"; 0 = never).
+  double min_cluster_fraction = 0.001;
   bool smooth_boundaries = true;        // §3.3 boundary smoothing after each channel
   std::size_t grain = 32;               // classes per parallel task when evaluating JS columns
 };
@@ -102,7 +104,7 @@ status run_channel(const P& ch, const M& m, const mesh_topology& topo, const clu
   }
   std::vector<std::uint32_t> scratch(nt, invalid_id), next(nt);
   std::uint32_t next_count = 0;
-  const region_growing_options go{static_cast<double>(ch.threshold), o.min_cluster_fraction, o.grain};
+  const region_growing_options go{static_cast<double>(ch.threshold), o.min_cluster_fraction, o.grain, nt};
   for (std::uint32_t k = 0; k < count; ++k) {
     const std::span<const std::uint32_t> set(tris.data() + offsets[k], offsets[k + 1] - offsets[k]);
     auto clock = std::chrono::steady_clock::now();

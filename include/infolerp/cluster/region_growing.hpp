@@ -29,9 +29,12 @@
 //   growth       all seeds grow together ring by ring; an element claimed by several seeds in
 //                one ring joins the one with the smallest JS, then the smallest seed index.
 //   sequential   leftover elements in index order each seed a new cluster grown breadth-first.
-//   merging      clusters with fewer than min_cluster_fraction·M elements join the neighbouring
+//   merging      clusters with fewer than min_cluster_fraction·N elements join the neighbouring
 //                cluster whose seed has the smallest JS to theirs (ties: smallest id), in passes
-//                (smallest first) until none can merge. Isolated small clusters stay.
+//                (smallest first) until none can merge. Isolated small clusters stay. N is
+//                fraction_of when set (cluster_mesh: the mesh's triangle count, the paper's "a
+//                given fraction of the input triangles", so the floor is the same for the small
+//                sets of later channels), else the set's own size M.
 //   numbering    clusters are numbered by their smallest element.
 // Every cluster is connected in the graph; results are identical for any executor.
 #include <algorithm>
@@ -82,6 +85,7 @@ struct region_growing_options {
   double threshold = 0.1;               // JS threshold Th in [0,1]
   double min_cluster_fraction = 0.001;  // §3.2.4: smaller clusters merge into a neighbour (0 = never)
   std::size_t grain = 32;               // classes per parallel task when evaluating JS columns
+  std::size_t fraction_of = 0;          // N of the merging floor fraction·N; 0 = the set's size
 };
 
 struct region_growing_result {
@@ -353,17 +357,11 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
   return seeds;
 }
 
-// §3.2 for one channel on one set: seeds, parallel growth, sequential pass, merging.
-// Errors: threshold or min_cluster_fraction outside [0,1] or NaN, graph/state size mismatch,
-// empty set. Complexity: dominated by the seeds' divergences (see select_seeds; growth adds at
-// most one per (seed, class) its frontier reaches), plus
-// O(M·degree) for growth and O(M·degree) per merging pass. Allocation O(M + seeds·U).
-// Thread-safety: the state's const members are called from the executor's threads.
-template <class S, class E>
-result<region_growing_result> grow_regions(const S& s, const element_graph& g, const region_growing_options& o,
-                                           E&& exec) {
-  static_assert(channel_state<S>, "infolerp: grow_regions needs a channel_state (see cluster/channel.hpp)");
-  static_assert(check_executor<std::remove_cvref_t<E>>());
+namespace detail {
+
+// Validates grow_regions' input; see there for the errors.
+template <class S>
+status check_region_growing(const S& s, const element_graph& g, const region_growing_options& o) {
   if (status st = check_threshold(o.threshold, "region growing"); !st) return st;
   if (!(o.min_cluster_fraction >= 0.0 && o.min_cluster_fraction <= 1.0))
     return make_error(errc::bad_parameter, no_element, "region growing: min_cluster_fraction ", o.min_cluster_fraction,
@@ -372,35 +370,42 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   if (m == 0) return make_error(errc::empty_input, no_element, "region growing: empty element set");
   if (g.size() != m)
     return make_error(errc::bad_size, no_element, "region growing: graph has ", g.size(), " elements, channel ", m);
-  const double th = o.threshold;
-  region_growing_result r;
-  if (th == 0.0) {  // one cluster per element
+  return {};
+}
+
+// The cases that need no divergence: Th = 0 (one cluster per element), Th = 1 or all rows alike
+// (one cluster per connected component). Returns false, leaving r empty, for the others.
+template <class S>
+bool trivial_clusters(const S& s, const element_graph& g, double th, region_growing_result& r) {
+  const std::size_t m = s.element_count();
+  if (th == 0.0) {
     r.cluster_of.resize(m);
     std::iota(r.cluster_of.begin(), r.cluster_of.end(), 0u);
     r.seeds = r.cluster_of;
     r.sequential_seeds = static_cast<std::uint32_t>(m);
-    return r;
+    return true;
   }
   bool alike = s.class_count() <= 1;
   if constexpr (requires { { s.all_alike() } -> std::convertible_to<bool>; }) alike = alike || s.all_alike();
-  if (alike || th >= 1.0) {
-    r.all_alike = alike;
-    detail::component_clusters(g, r);
-    return r;
-  }
+  if (!alike && th < 1.0) return false;
+  r.all_alike = alike;
+  component_clusters(g, r);
+  return true;
+}
 
-  const std::size_t u = s.class_count();
-  std::vector<std::uint32_t> cls(m), first_of(u, invalid_id);
-  for (std::uint32_t e = 0; e < m; ++e) {
-    cls[e] = s.class_of(e);
-    if (first_of[cls[e]] == invalid_id) first_of[cls[e]] = e;
-  }
-  std::vector<std::vector<float>> columns;
-  const std::vector<std::uint32_t> seed_classes = select_seeds(s, th, o.grain, exec, columns);
-  const std::size_t k0 = seed_classes.size();
+// §3.2.3, parallel: every seed class's first element grows one ring at a time; an element
+// claimed by several seeds in one ring joins the one with the smallest JS, then the smallest
+// seed index. `columns` are select_seeds' (entries filled in where the frontiers arrive).
+// Sets r.cluster_of (invalid_id where no seed arrived), r.seeds, r.parallel_seeds.
+template <class S, class E>
+void grow_rings(const S& s, const element_graph& g, std::span<const std::uint32_t> cls,
+                std::span<const std::uint32_t> seed_classes, std::vector<std::vector<float>>& columns, double th,
+                std::size_t grain, E& exec, region_growing_result& r) {
+  const std::size_t m = cls.size(), k0 = seed_classes.size();
   r.parallel_seeds = static_cast<std::uint32_t>(k0);
-
-  // Parallel growth, ring by ring.
+  std::vector<std::uint32_t> first_of(s.class_count(), invalid_id);
+  for (std::uint32_t e = 0; e < m; ++e)
+    if (first_of[cls[e]] == invalid_id) first_of[cls[e]] = e;
   std::vector<std::uint32_t>& label = r.cluster_of;
   label.assign(m, invalid_id);
   std::vector<std::vector<std::uint32_t>> frontier(k0);
@@ -419,18 +424,18 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
       missing[k].clear();
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f))
-          if (label[n] == invalid_id && columns[k][cls[n]] == detail::js_unknown) {
-            columns[k][cls[n]] = detail::js_pending;
+          if (label[n] == invalid_id && columns[k][cls[n]] == js_unknown) {
+            columns[k][cls[n]] = js_pending;
             missing[k].push_back(cls[n]);
           }
       std::sort(missing[k].begin(), missing[k].end());
-      detail::js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), o.grain, exec, th);
+      js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), grain, exec, th);
     }
     // A js_bounded entry is similar; its value is needed only when a second seed claims the
     // same element in this ring (then both values are made exact, in this fixed order).
     auto exact = [&](std::uint32_t k, std::uint32_t c) {
       float& js = columns[k][c];
-      if (js == detail::js_bounded) js = static_cast<float>(s.divergence(seed_classes[k], c));
+      if (js == js_bounded) js = static_cast<float>(s.divergence(seed_classes[k], c));
       return js;
     };
     for (std::uint32_t k = 0; k < k0; ++k)
@@ -438,7 +443,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
         for (std::uint32_t n : g.neighbours_of(f)) {
           if (label[n] != invalid_id) continue;
           float js = columns[k][cls[n]];
-          if (js != detail::js_bounded && !is_similar(js, th)) continue;
+          if (js != js_bounded && !is_similar(js, th)) continue;
           if (best_k[n] == invalid_id) {
             touched.push_back(n);
           } else if (best_k[n] != k) {
@@ -459,14 +464,19 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
     }
     any = !touched.empty();
   }
-  columns.clear();
-  columns.shrink_to_fit();
+}
 
-  // Sequential pass over leftovers; "JS < Th" to the current seed memoised per class (stamped).
-  const double err = detail::estimate_error_of(s);
-  std::vector<std::uint8_t> memo(u);
-  std::vector<std::uint32_t> stamp(u, invalid_id), queue;
-  for (std::uint32_t e = 0; e < m; ++e) {
+// §3.2.3, sequential: each element no seed reached, in index order, seeds a new cluster grown
+// breadth-first over elements with JS < Th to it ("JS < Th" memoised per class, stamped by
+// cluster; decided by the state's estimate where it can).
+template <class S>
+void grow_leftovers(const S& s, const element_graph& g, std::span<const std::uint32_t> cls, double th,
+                    region_growing_result& r) {
+  std::vector<std::uint32_t>& label = r.cluster_of;
+  const double err = estimate_error_of(s);
+  std::vector<std::uint8_t> memo(s.class_count());
+  std::vector<std::uint32_t> stamp(s.class_count(), invalid_id), queue;
+  for (std::uint32_t e = 0; e < cls.size(); ++e) {
     if (label[e] != invalid_id) continue;
     const auto k = static_cast<std::uint32_t>(r.seeds.size());
     r.seeds.push_back(e);
@@ -475,7 +485,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
     queue.assign(1, e);
     const std::uint32_t sc = cls[e];
     for (std::size_t q = 0; q < queue.size(); ++q) {
-      if constexpr (detail::has_prefetch<S>)  // the rows tested next, a hint (far apart in memory)
+      if constexpr (has_prefetch<S>)  // the rows tested next, a hint (far apart in memory)
         if (q + 1 < queue.size())
           for (std::uint32_t n : g.neighbours_of(queue[q + 1]))
             if (label[n] == invalid_id) s.prefetch(cls[n]);
@@ -483,7 +493,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
         if (label[n] != invalid_id) continue;
         if (stamp[cls[n]] != k) {
           stamp[cls[n]] = k;
-          memo[cls[n]] = detail::similar(s, sc, cls[n], th, err) ? 1 : 0;
+          memo[cls[n]] = similar(s, sc, cls[n], th, err) ? 1 : 0;
         }
         if (!memo[cls[n]]) continue;
         label[n] = k;
@@ -491,59 +501,105 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
       }
     }
   }
+}
 
-  // §3.2.4 merging, in passes.
-  const double min_size = o.min_cluster_fraction * static_cast<double>(m);
-  for (bool changed = true; changed && min_size > 1.0;) {
-    changed = false;
-    const std::size_t kc = r.seeds.size();
-    std::vector<double> size(kc, 0.0);
-    for (std::uint32_t l : label) size[l] += 1.0;
-    std::vector<std::uint32_t> small;
-    for (std::uint32_t k = 0; k < kc; ++k)
-      if (size[k] < min_size) small.push_back(k);
-    if (small.empty()) break;
-    // Neighbouring clusters of each small cluster.
-    std::vector<std::uint32_t> is_small(kc, invalid_id);
-    for (std::uint32_t i = 0; i < small.size(); ++i) is_small[small[i]] = i;
-    std::vector<std::vector<std::uint32_t>> adj(small.size());
-    for (std::uint32_t e = 0; e < m; ++e) {
-      const std::uint32_t si = is_small[label[e]];
-      if (si == invalid_id) continue;
-      for (std::uint32_t n : g.neighbours_of(e))
-        if (label[n] != label[e]) adj[si].push_back(label[n]);
-    }
-    std::vector<std::uint32_t> parent(kc);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](std::uint32_t x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    std::vector<std::uint32_t> order(small.begin(), small.end());
-    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] < size[b]; });
-    for (std::uint32_t a : order) {
-      if (find(a) != a || size[a] >= min_size) continue;
-      std::uint32_t best = invalid_id;
-      double best_d = 0.0;
-      for (std::uint32_t nb : adj[is_small[a]]) {
-        const std::uint32_t b = find(nb);
-        if (b == a) continue;
-        const double d = s.divergence(cls[r.seeds[a]], cls[r.seeds[b]]);
-        if (best == invalid_id || d < best_d || (d == best_d && b < best)) {
-          best = b;
-          best_d = d;
-        }
-      }
-      if (best == invalid_id) continue;
-      parent[a] = best;
-      size[best] += size[a];
-      ++r.merged;
-      changed = true;
-    }
-    for (auto& l : label) l = find(l);
-    detail::canonical_numbering(label, r.seeds);
+// One §3.2.4 pass: every cluster under min_size, smallest first, joins the neighbouring
+// cluster whose seed has the smallest JS to its seed (ties: smallest id). Returns whether any
+// merged; renumbers canonically.
+template <class S>
+bool merge_pass(const S& s, const element_graph& g, std::span<const std::uint32_t> cls, double min_size,
+                region_growing_result& r) {
+  std::vector<std::uint32_t>& label = r.cluster_of;
+  const std::size_t kc = r.seeds.size();
+  std::vector<double> size(kc, 0.0);
+  for (std::uint32_t l : label) size[l] += 1.0;
+  std::vector<std::uint32_t> small;
+  for (std::uint32_t k = 0; k < kc; ++k)
+    if (size[k] < min_size) small.push_back(k);
+  if (small.empty()) return false;
+  // Neighbouring clusters of each small cluster.
+  std::vector<std::uint32_t> is_small(kc, invalid_id);
+  for (std::uint32_t i = 0; i < small.size(); ++i) is_small[small[i]] = i;
+  std::vector<std::vector<std::uint32_t>> adj(small.size());
+  for (std::uint32_t e = 0; e < label.size(); ++e) {
+    const std::uint32_t si = is_small[label[e]];
+    if (si == invalid_id) continue;
+    for (std::uint32_t n : g.neighbours_of(e))
+      if (label[n] != label[e]) adj[si].push_back(label[n]);
   }
-  detail::canonical_numbering(label, r.seeds);
+  for (auto& a : adj) {  // one divergence per neighbouring cluster (the choice is order-free)
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  std::vector<std::uint32_t> parent(kc);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<std::uint32_t> order(small.begin(), small.end());
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] < size[b]; });
+  bool changed = false;
+  for (std::uint32_t a : order) {
+    if (find(a) != a || size[a] >= min_size) continue;
+    std::uint32_t best = invalid_id;
+    double best_d = 0.0;
+    for (std::uint32_t nb : adj[is_small[a]]) {
+      const std::uint32_t b = find(nb);
+      if (b == a) continue;
+      const double d = s.divergence(cls[r.seeds[a]], cls[r.seeds[b]]);
+      if (best == invalid_id || d < best_d || (d == best_d && b < best)) {
+        best = b;
+        best_d = d;
+      }
+    }
+    if (best == invalid_id) continue;
+    parent[a] = best;
+    size[best] += size[a];
+    ++r.merged;
+    changed = true;
+  }
+  for (auto& l : label) l = find(l);
+  canonical_numbering(label, r.seeds);
+  return changed;
+}
+
+// §3.2.4: merging passes until none merges (nothing when min_size <= 1).
+template <class S>
+void merge_small_clusters(const S& s, const element_graph& g, std::span<const std::uint32_t> cls, double min_size,
+                          region_growing_result& r) {
+  if (min_size > 1.0)
+    while (merge_pass(s, g, cls, min_size, r)) {
+    }
+}
+
+}  // namespace detail
+
+// §3.2 for one channel on one set: seeds, parallel growth, sequential pass, merging.
+// Errors: threshold or min_cluster_fraction outside [0,1] or NaN, graph/state size mismatch,
+// empty set. Complexity: dominated by the seeds' divergences (see select_seeds; growth adds at
+// most one per (seed, class) its frontier reaches), plus
+// O(M·degree) for growth and O(M·degree) per merging pass. Allocation O(M + seeds·U).
+// Thread-safety: the state's const members are called from the executor's threads.
+template <class S, class E>
+result<region_growing_result> grow_regions(const S& s, const element_graph& g, const region_growing_options& o,
+                                           E&& exec) {
+  static_assert(channel_state<S>, "infolerp: grow_regions needs a channel_state (see cluster/channel.hpp)");
+  static_assert(check_executor<std::remove_cvref_t<E>>());
+  if (status st = detail::check_region_growing(s, g, o); !st) return st;
+  region_growing_result r;
+  if (detail::trivial_clusters(s, g, o.threshold, r)) return r;
+  const std::size_t m = s.element_count();
+  std::vector<std::uint32_t> cls(m);
+  for (std::uint32_t e = 0; e < m; ++e) cls[e] = s.class_of(e);
+  std::vector<std::vector<float>> columns;
+  const std::vector<std::uint32_t> seed_classes = select_seeds(s, o.threshold, o.grain, exec, columns);  // §3.2.2
+  detail::grow_rings(s, g, cls, seed_classes, columns, o.threshold, o.grain, exec, r);                 // §3.2.3
+  columns = {};
+  detail::grow_leftovers(s, g, cls, o.threshold, r);
+  const double min_size = o.min_cluster_fraction * static_cast<double>(o.fraction_of ? o.fraction_of : m);
+  detail::merge_small_clusters(s, g, cls, min_size, r);  // §3.2.4
+  detail::canonical_numbering(r.cluster_of, r.seeds);
   return r;
 }
 

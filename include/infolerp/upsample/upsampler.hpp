@@ -414,14 +414,14 @@ class upsampler {
       Sample p = src.probe(x, y);
       chosen k;
       if constexpr (refining_sample_source<S>) {
-        k = choose_sources(src, p, r0, r1, i, j, false, cross_check, true, probe_match);
+        k = choose_sources(src, p, r0, r1, i, j, {.single = false, .cross = cross_check, .bracket = true}, probe_match);
         if (k.n == 0) {
           p = src.refine_probe(p, x, y);
           const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
-          k = choose_sources(src, p, r0, r1, i, j, single, false, false, full_match);
+          k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = false, .bracket = false}, full_match);
         }
       } else {
-        k = choose_sources(src, p, r0, r1, i, j, single, cross_check, false, probe_match);
+        k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = cross_check, .bracket = false}, probe_match);
       }
       if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
                                  : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
@@ -443,16 +443,24 @@ class upsampler {
     unsigned n = 0;
   };
 
+  // What choose_sources accepts besides match(p, source).
+  struct source_rule {
+    bool single = false;   // one matching source suffices (an edge's, or a lone corner)
+    bool cross = false;    // the chosen sources must also be compatible() with each other
+    bool bracket = false;  // an adjacent pair of corners (the centre is not between them) does not do
+  };
+
   // Chooses the sources of probe p of the new sample (i, j) among the previous-pass samples
-  // (rows r0 and r1) that match(p, source) accepts. Edge: both sources, or one when `single`.
-  // Centre, by the matching corners: all four (weights 1/4); three, the diagonal opposite the
-  // missing corner (the centre is its midpoint, so a plane through the three corners is
-  // reproduced exactly); two, that pair; one, that corner when `single`. With `cross`, the
-  // chosen sources must also be compatible() with each other; with `bracket`, an adjacent pair
-  // of corners (the centre is not between them) does not suffice.
+  // (rows r0 and r1) that match(p, source) accepts. Edge: both sources, or one when
+  // rule.single. Centre, by the matching corners: all four (weights 1/4); three, the diagonal
+  // opposite the missing corner (the centre is its midpoint, so a plane through the three
+  // corners is reproduced exactly); two, that pair unless rule.bracket and they are adjacent;
+  // one, that corner when rule.single. With rule.cross, the chosen sources must also be
+  // compatible() with each other.
   template <class S, class M>
   static chosen choose_sources(const S& src, const Sample& p, const Sample* r0, const Sample* r1, std::uint32_t i,
-                               std::uint32_t j, bool single, bool cross, bool bracket, const M& match) {
+                               std::uint32_t j, source_rule rule, const M& match) {
+    const bool single = rule.single, cross = rule.cross, bracket = rule.bracket;
     const std::uint32_t a = i / 2;
     if (!((i & 1u) && (j & 1u))) {  // edge
       const Sample* s0 = &r0[a];
