@@ -2,7 +2,8 @@
 #   MODE=errors  bad options and bad files: each gives exit code 1 or 2 (not a signal) and exactly
 #                one line on stderr that says what is wrong
 #   MODE=run     a small run (65x65, AO 4, soft 2, --threads 2, then --passes auto at 33x33):
-#                exit 0 and every output file written
+#                exit 0 and every output file written; then two --mesh files (33x33), each
+#                reported with what it lacks
 # Arguments: -DDEMO=<infolerp_demo> -DWORK_DIR=<scratch dir> -DMODE=errors|run
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
@@ -60,6 +61,10 @@ if(MODE STREQUAL "errors")
   expect_error(1 "vertex 2: non-finite position" --mesh ${WORK_DIR}/nan.off)
   file(WRITE ${WORK_DIR}/broken.obj "v 0 0 0\nv 1 0 0\nf 1 2 7\n")
   expect_error(1 "mesh '${WORK_DIR}/broken.obj'" --mesh ${WORK_DIR}/broken.obj)
+  # A material whose diffuse texture is missing.
+  file(WRITE ${WORK_DIR}/tri.obj "mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n")
+  file(WRITE ${WORK_DIR}/tri.mtl "newmtl m\nKd 1 1 1\nmap_Kd missing.png\n")
+  expect_error(1 "cannot read texture '${WORK_DIR}/missing.png'" --mesh ${WORK_DIR}/tri.obj)
 
   # An output directory that cannot be created (a regular file is in the way).
   file(WRITE ${WORK_DIR}/file "x")
@@ -100,4 +105,14 @@ elseif(MODE STREQUAL "run")
     message(FATAL_ERROR "--passes auto: exit '${rc}'\n${out}\n${err}")
   endif()
   expect_files(${WORK_DIR}/auto/ibuffer.png ${WORK_DIR}/auto/summary.csv)
+
+  # --mesh is repeatable; meshes without a texture or without texcoords say what is skipped.
+  file(WRITE ${WORK_DIR}/quad.obj "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+  file(WRITE ${WORK_DIR}/quad.off "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n")
+  execute_process(COMMAND ${DEMO} --size 33 33 --ao 2 --soft 1 --mesh ${WORK_DIR}/quad.obj --mesh ${WORK_DIR}/quad.off
+                          --out ${WORK_DIR}/meshes RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "scene: 6 objects" OR NOT out MATCHES "quad.obj[^\n]*no diffuse texture"
+     OR NOT out MATCHES "quad.off[^\n]*no texcoords: stretch channel skipped")
+    message(FATAL_ERROR "two --mesh: exit '${rc}'\n${out}\n${err}")
+  endif()
 endif()

@@ -19,7 +19,7 @@
 // PSNR (display values) and SSIM (display luma) are against per_pixel's image. With --pictures,
 // OUT/reference.png, OUT/ibuffer.png (the fastest row with >= 40 dB and SSIM >= 0.98, else the
 // best PSNR) and OUT/clusters.png (cluster ids, boundaries dark, texture-chart seams white),
-// cropped to the asset.
+// cropped to at most 272x272 pixels at the asset's centre.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -187,11 +187,13 @@ void write_pictures(const textured_options& o, const sup::demo_scene& scene, con
     for (int x = 0; x + 1 < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
       const std::size_t right = i + 1, down = i + static_cast<std::size_t>(w);
-      if (chart[i] != chart[right] || chart[i] != chart[down]) img.at(x, y) = glm::vec3(1.0f);
+      const auto seam = [&](std::size_t j) { return chart[i] != infolerp::invalid_id && chart[j] != infolerp::invalid_id && chart[i] != chart[j]; };
+      if (seam(right) || seam(down)) img.at(x, y) = glm::vec3(1.0f);
       else if (id[i] != id[right] || id[i] != id[down]) img.at(x, y) *= 0.3f;
     }
-  const int margin = 8;
-  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin), x1 = std::min(w, x1 + margin), y1 = std::min(h, y1 + margin);
+  // At most 272 x 272 pixels around the asset's centre (small files, full resolution).
+  const int cx = (x0 + x1) / 2, cy = (y0 + y1) / 2, half = 136;
+  x0 = std::max({0, x0, cx - half}), y0 = std::max({0, y0, cy - half}), x1 = std::min({w, x1, cx + half}), y1 = std::min({h, y1, cy + half});
   const row* best = nullptr;
   for (const auto& r : rows) {
     if (r.method != "ibuffer" && r.method != "ibuffer_refine") continue;

@@ -1,4 +1,4 @@
-// infolerp_demo: renders the built-in demo scene (plus an optional --mesh) with the full
+// infolerp_demo: renders the built-in demo scene (plus any --mesh assets, textured) with the full
 // per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
 // saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), the
 // view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,

@@ -45,16 +45,14 @@ result<std::shared_ptr<const texture>> material_texture(const aiScene& scene, co
   if (mat.GetTexture(aiTextureType_DIFFUSE, 0, &name) != AI_SUCCESS &&
       mat.GetTexture(aiTextureType_BASE_COLOR, 0, &name) != AI_SUCCESS)
     return std::shared_ptr<const texture>{};
-  result<texture> t = make_error(errc::bad_parameter, no_element, "texture '", name.C_Str(), "' of '", path, "'");
-  if (const aiTexture* embedded = scene.GetEmbeddedTexture(name.C_Str())) {
-    if (embedded->mHeight != 0)
-      return make_error(errc::bad_parameter, no_element, "'", path, "': uncompressed embedded texture '", name.C_Str(),
-                        "' is not supported");
-    const auto* bytes = reinterpret_cast<const unsigned char*>(embedded->pcData);
-    t = decode_texture(std::span<const unsigned char>(bytes, embedded->mWidth), path + ":" + name.C_Str());
-  } else {
-    t = load_texture((std::filesystem::path(path).parent_path() / name.C_Str()).string());
-  }
+  const aiTexture* embedded = scene.GetEmbeddedTexture(name.C_Str());
+  if (embedded != nullptr && embedded->mHeight != 0)
+    return make_error(errc::bad_parameter, no_element, "'", path, "': uncompressed embedded texture '", name.C_Str(),
+                      "' is not supported");
+  auto t = embedded != nullptr
+               ? decode_texture(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(embedded->pcData), embedded->mWidth),
+                                path + ":" + name.C_Str())
+               : load_texture((std::filesystem::path(path).parent_path() / name.C_Str()).string());
   if (!t) return t.error();
   return std::shared_ptr<const texture>(std::make_shared<texture>(std::move(*t)));
 }
