@@ -8,9 +8,11 @@
 // both ends. Contractions are half-edge collapses u → v (u is removed, v keeps its position),
 // so every level of detail indexes the original vertices and the per-view pass only remaps
 // indices. Cost of u → v: (Q_u + Q_v)(p_v); pairs are ordered globally over the whole mesh
-// (connectivity across cluster borders is kept) by (cost, u, v) in a binary heap with lazy
-// deletion; when the heap runs dry the remaining edges are queued once more, until a round
-// performs no contraction.
+// (connectivity across cluster borders is kept) by (cost, u, v): a binary heap holds each
+// vertex's cheapest contraction, updated in place when a contraction changes the vertex's
+// quadric or neighbours; a vertex whose cheapest contraction is refused is queued with its
+// cheapest allowed one, or left out until its neighbourhood changes. When the heap runs dry
+// every vertex is queued once more, until a round performs no contraction.
 // A contraction is refused when it would: create a non-manifold edge or a duplicate triangle
 // (link condition: the common neighbours of u and v are exactly the vertices opposite edge uv),
 // flip or flatten a triangle (the angle between old and new normal must stay below
@@ -45,6 +47,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -133,25 +136,80 @@ inline double sum_eval(const quadric& q0, const quadric& q1, const glm::dvec3& p
   return q.eval(p);
 }
 
+// Vertex u's cheapest contraction u → v.
 struct collapse_entry {
   double cost;
-  std::uint32_t u, v, ver_u, ver_v;
-  bool operator>(const collapse_entry& o) const {
-    if (cost != o.cost) return cost > o.cost;
-    if (u != o.u) return u > o.u;
-    return v > o.v;
+  std::uint32_t u, v;
+  bool operator<(const collapse_entry& o) const {
+    if (cost != o.cost) return cost < o.cost;
+    if (u != o.u) return u < o.u;
+    return v < o.v;
   }
 };
 
+// Binary min-heap of collapse entries, at most one per vertex, with each vertex's slot known so
+// that its entry is replaced in place: O(log V) per update, no stale entries, no allocation
+// after reset.
+class vertex_heap {
+ public:
+  static constexpr std::uint32_t none = invalid_id;
+  void reset(std::size_t vertices) {
+    slot_.assign(vertices, none);
+    heap_.clear();
+    heap_.reserve(vertices);
+  }
+  [[nodiscard]] bool empty() const { return heap_.empty(); }
+  [[nodiscard]] const collapse_entry& top() const { return heap_.front(); }
+  [[nodiscard]] const collapse_entry* find(std::uint32_t u) const { return slot_[u] == none ? nullptr : &heap_[slot_[u]]; }
+  // Inserts u's entry or replaces it.
+  void set(const collapse_entry& e) {
+    std::uint32_t i = slot_[e.u];
+    if (i == none) {
+      i = static_cast<std::uint32_t>(heap_.size());
+      heap_.push_back(e);
+    } else {
+      heap_[i] = e;
+    }
+    place(i);
+  }
+  void erase(std::uint32_t u) {
+    const std::uint32_t i = slot_[u];
+    if (i == none) return;
+    slot_[u] = none;
+    const collapse_entry last = heap_.back();
+    heap_.pop_back();
+    if (i == heap_.size()) return;
+    heap_[i] = last;
+    place(i);
+  }
+
+ private:
+  void put(std::uint32_t i, const collapse_entry& e) { heap_[i] = e, slot_[e.u] = i; }
+  void place(std::uint32_t i) {  // sift heap_[i] up or down
+    const collapse_entry e = heap_[i];
+    while (i > 0 && e < heap_[(i - 1) / 2]) put(i, heap_[(i - 1) / 2]), i = (i - 1) / 2;
+    for (;;) {
+      std::uint32_t c = 2 * i + 1;
+      if (c >= heap_.size()) break;
+      if (c + 1 < heap_.size() && heap_[c + 1] < heap_[c]) ++c;
+      if (!(heap_[c] < e)) break;
+      put(i, heap_[c]), i = c;
+    }
+    put(i, e);
+  }
+  std::vector<collapse_entry> heap_;
+  std::vector<std::uint32_t> slot_;
+};
+
 // The mutable mesh of the build: triangles with per-vertex corner lists (singly linked, dead
-// triangles unlinked lazily), quadrics and heap versions.
+// triangles unlinked lazily) and quadrics.
 class collapse_mesh {
  public:
   static constexpr std::uint32_t nil = invalid_id;
   std::vector<glm::dvec3> pos;
   std::vector<glm::uvec3> tri;
   std::vector<char> tri_alive, alive, boundary;
-  std::vector<std::uint32_t> head, next, version, stamp, last_touch;
+  std::vector<std::uint32_t> head, next, stamp, last_touch;
   std::vector<quadric> q;
   std::uint32_t stamp_now = 0;
   std::vector<std::uint32_t> ring_u, ring_v;
@@ -254,7 +312,6 @@ class collapse_mesh {
     head[u] = nil;
     alive[u] = 0;
     q[v] += q[u];
-    ++version[u], ++version[v];
     return removed;
   }
 };
@@ -310,7 +367,6 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   cm.boundary.assign(nv, 0);
   cm.head.assign(nv, detail::collapse_mesh::nil);
   cm.next.assign(3 * nt, detail::collapse_mesh::nil);
-  cm.version.assign(nv, 0);
   cm.stamp.assign(nv, 0);
   cm.last_touch.assign(nv, no_parent);
   cm.q.assign(nv, {});
@@ -367,24 +423,26 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   std::vector<std::pair<std::uint32_t, cross_dependency>> crossing;  // (owner, entry), ascending order
   std::vector<std::pair<std::uint32_t, std::uint32_t>> dep_scratch;  // (cluster, order) of dependencies
 
-  std::vector<detail::collapse_entry> heap;
-  auto push = [&](std::uint32_t u, std::uint32_t v) {
-    heap.push_back({detail::sum_eval(cm.q[u], cm.q[v], cm.pos[v]), u, v, cm.version[u], cm.version[v]});
-    std::push_heap(heap.begin(), heap.end(), std::greater<>{});
+  // One heap entry per vertex: its cheapest contraction (the global minimum over pairs is the
+  // minimum over vertices). A contraction u → v changes the costs of v and of v's new
+  // neighbours, whose entries are recomputed.
+  detail::vertex_heap heap;
+  heap.reset(nv);
+  std::vector<std::uint32_t> candidates;
+  std::vector<std::pair<double, std::uint32_t>> ranked;
+  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::sum_eval(cm.q[u], cm.q[v], cm.pos[v]); };
+  auto set_best = [&](std::uint32_t u) {
+    cm.ring(u, candidates);
+    detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
+    for (std::uint32_t v : candidates)
+      if (const detail::collapse_entry e{cost(u, v), u, v}; e < best) best = e;
+    if (best.v != invalid_id) heap.set(best);
+    else heap.erase(u);
   };
   auto fill = [&] {
-    heap.clear();
-    for (std::size_t t = 0; t < nt; ++t) {
-      if (!cm.tri_alive[t]) continue;
-      const glm::uvec3 f = cm.tri[t];
-      for (int j = 0; j < 3; ++j) {
-        const std::uint32_t a = f[j], b = f[(j + 1) % 3];
-        // Each interior edge is seen from two triangles; queue it from the one where a < b.
-        heap.push_back({detail::sum_eval(cm.q[a], cm.q[b], cm.pos[b]), a, b, cm.version[a], cm.version[b]});
-        heap.push_back({detail::sum_eval(cm.q[a], cm.q[b], cm.pos[a]), b, a, cm.version[b], cm.version[a]});
-      }
-    }
-    std::make_heap(heap.begin(), heap.end(), std::greater<>{});
+    heap.reset(nv);
+    for (std::uint32_t x = 0; x < nv; ++x)
+      if (cm.alive[x]) set_best(x);
   };
   fill();
   bool progress_since_fill = false, local_phase = opt.cluster_local_first;
@@ -392,6 +450,21 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     for (std::uint32_t x : cm.ring_u) if (owner[x] != c) return false;
     for (std::uint32_t x : cm.ring_v) if (owner[x] != c) return false;
     return true;
+  };
+  auto valid = [&](std::uint32_t u, std::uint32_t v) {
+    return cm.can_collapse(u, v, opt.min_normal_cos) && (!local_phase || local_to_cluster(owner[u]));
+  };
+  // u's cheapest contraction failed the tests: queue its cheapest valid one, or drop u until its
+  // neighbourhood changes (or the next round).
+  auto requeue = [&](std::uint32_t u, std::uint32_t failed) {
+    cm.ring(u, candidates);
+    ranked.clear();
+    for (std::uint32_t v : candidates)
+      if (v != failed) ranked.push_back({cost(u, v), v});
+    std::sort(ranked.begin(), ranked.end());
+    for (const auto& [c, v] : ranked)
+      if (valid(u, v)) return heap.set({c, u, v});
+    heap.erase(u);
   };
   while (live > floor_count) {
     if (heap.empty()) {
@@ -404,12 +477,12 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       fill();
       continue;
     }
-    std::pop_heap(heap.begin(), heap.end(), std::greater<>{});
-    const detail::collapse_entry e = heap.back();
-    heap.pop_back();
-    if (!cm.alive[e.u] || !cm.alive[e.v] || cm.version[e.u] != e.ver_u || cm.version[e.v] != e.ver_v) continue;
-    if (!cm.can_collapse(e.u, e.v, opt.min_normal_cos)) continue;
-    if (local_phase && !local_to_cluster(owner[e.u])) continue;
+    const detail::collapse_entry e = heap.top();
+    if (!valid(e.u, e.v)) {
+      requeue(e.u, e.v);
+      continue;
+    }
+    heap.erase(e.u);
     // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
     const auto order = static_cast<std::uint32_t>(h.removed.size());
     std::uint32_t parent = no_parent;
@@ -437,7 +510,17 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     --live;
     progress_since_fill = true;
     cm.ring(e.v, cm.ring_v);
-    for (std::uint32_t x : cm.ring_v) push(e.v, x), push(x, e.v);
+    set_best(e.v);
+    // A neighbour x of v: only x → v changed (Q_v grew) or vanished (x → u); an entry aiming
+    // elsewhere stays exact unless x → v now beats it.
+    for (std::uint32_t x : cm.ring_v) {
+      const detail::collapse_entry* old = heap.find(x);
+      if (!old || old->v == e.u || old->v == e.v) {
+        set_best(x);
+      } else if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) {
+        heap.set(to_v);
+      }
+    }
   }
 
   if (local_phase) h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
