@@ -11,6 +11,7 @@
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/saliency/mesh_saliency.hpp"
 #include "infolerp/saliency/salient_clustering.hpp"
+#include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
 namespace {
@@ -88,6 +89,131 @@ TEST_CASE("salient clustering: every face in exactly one connected cluster, dete
   REQUIRE(first.ok());
   const std::set<std::uint32_t> pool(order.begin(), order.begin() + 50);
   for (auto v : first->seeds) CHECK(pool.count(v) == 1);
+}
+
+namespace {
+// A strip of n quads, two triangles each: A_i = (b_i, b_i+1, t_i+1), B_i = (b_i, t_i+1, t_i) with
+// b_i = vertex i, t_i = vertex n + 1 + i. Faces in quad order, except that `last` and
+// `second_last` (indices into that order) are moved to the end.
+infolerp::indexed_mesh strip(unsigned n, std::size_t second_last, std::size_t last) {
+  infolerp::indexed_mesh m;
+  for (unsigned i = 0; i <= n; ++i) m.positions.push_back({static_cast<float>(i), 0.0f, 0.0f});
+  for (unsigned i = 0; i <= n; ++i) m.positions.push_back({static_cast<float>(i), 1.0f, 0.0f});
+  std::vector<glm::uvec3> faces;
+  for (unsigned i = 0; i < n; ++i) {
+    faces.push_back({i, i + 1, n + 2 + i});
+    faces.push_back({i, n + 2 + i, n + 1 + i});
+  }
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    if (f != last && f != second_last) m.triangles.push_back(faces[f]);
+  m.triangles.push_back(faces[second_last]);
+  m.triangles.push_back(faces[last]);
+  return m;
+}
+
+// Mean distance from each face centroid with all-zero corner saliency to its cluster's seed.
+double flat_distance_to_seed(const infolerp::indexed_mesh& m, const std::vector<double>& sal,
+                             const infolerp::salient_clusters& c) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const glm::uvec3 tri = m.triangles[t];
+    if (sal[tri.x] != 0.0 || sal[tri.y] != 0.0 || sal[tri.z] != 0.0) continue;
+    const glm::vec3 centre = (m.positions[tri.x] + m.positions[tri.y] + m.positions[tri.z]) / 3.0f;
+    sum += glm::length(centre - m.positions[c.seeds[c.cluster[t]]]);
+    ++count;
+  }
+  return count ? sum / count : 0.0;
+}
+}  // namespace
+
+TEST_CASE("salient clustering: re-seeding gives distinct seeds when thin clusters' last faces share a vertex") {
+  // 8 quads; cluster 0 = quads 0-3, cluster 1 = quads 4-7. Every face of a one-quad strip is on
+  // the border, so re-seeding takes each cluster's highest-numbered face: A_3 and B_4 (moved to
+  // the end), which share the middle vertices b_4 and t_4; b_4 is the most salient of both.
+  const unsigned n = 8;
+  const auto m = strip(n, 2 * 4 + 1, 2 * 3);
+  std::vector<double> sal(m.positions.size());
+  for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 0.1 + 0.01 * static_cast<double>(v);
+  sal[4] = 1.0;
+  const auto topo = *infolerp::build_topology(m);
+  const auto fd = infolerp::detail::make_face_data(m, topo, sal);
+  std::vector<std::uint32_t> label(m.triangles.size());
+  for (std::size_t i = 0; i < label.size(); ++i) {
+    const glm::uvec3 tri = m.triangles[fd.original[i]];
+    label[i] = std::min({tri.x, tri.y, tri.z}) % (n + 1) < 4 ? 0u : 1u;  // quad index < 4
+  }
+  infolerp::detail::clustering_workspace ws;
+  const std::vector<std::uint32_t> old_seeds{0, n};
+  const auto seeds = infolerp::detail::reseed(m, fd, label, sal, old_seeds, ws);
+  REQUIRE(seeds.size() == 2);
+  CHECK(seeds[0] == 4);
+  CHECK(seeds[1] != seeds[0]);
+
+  // End to end on the same strip: distinct seeds and no empty cluster, for several C and seeds.
+  for (std::uint32_t clusters : {2u, 3u, 4u})
+    for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
+      auto r = infolerp::salient_clustering(m, sal, {.clusters = clusters, .pool_multiplier = 2.0, .seed = seed});
+      REQUIRE(r.ok());
+      INFO("clusters " << clusters << " seed " << seed);
+      CHECK(std::set<std::uint32_t>(r->seeds.begin(), r->seeds.end()).size() == clusters);
+      std::vector<int> size(r->count, 0);
+      for (auto c : r->cluster) ++size[c];
+      for (int z : size) CHECK(z > 0);
+    }
+}
+
+TEST_CASE("salient clustering: flat regions are shared by distance, not flooded by the first cluster") {
+  // A plane whose saliency is exactly 0 except at two vertices near opposite corners. Eq. 2
+  // costs 0 between two zero-saliency faces, so without the tie-break the cluster that enters
+  // the flat part first takes all of it.
+  const auto m = infolerp::support::make_plane(24, 24, 2.0f);
+  std::vector<double> sal(m.positions.size(), 0.0);
+  std::size_t a = 0, b = 0;
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    if (glm::length(m.positions[v] - glm::vec3(-0.6f, -0.6f, 0.0f)) < glm::length(m.positions[a] - glm::vec3(-0.6f, -0.6f, 0.0f))) a = v;
+    if (glm::length(m.positions[v] - glm::vec3(0.6f, 0.6f, 0.0f)) < glm::length(m.positions[b] - glm::vec3(0.6f, 0.6f, 0.0f))) b = v;
+  }
+  sal[a] = 1.0, sal[b] = 0.9;
+  // normal_weight 2: on a plane the normal factor of eq. 2 is then 1, not 0.
+  infolerp::salient_clustering_options opt{.clusters = 2, .pool_multiplier = 1.0, .normal_weight = 2.0, .max_iterations = 1};
+  std::vector<double> share[2];
+  double distance[2];
+  for (int tie_break = 0; tie_break < 2; ++tie_break) {
+    opt.flat_tie_break = tie_break == 1;
+    auto r = infolerp::salient_clustering(m, sal, opt);
+    REQUIRE(r.ok());
+    std::vector<double> size(2, 0.0);
+    for (auto c : r->cluster) size[c] += 1.0 / static_cast<double>(m.triangles.size());
+    share[tie_break] = size;
+    distance[tie_break] = flat_distance_to_seed(m, sal, *r);
+  }
+  INFO("cluster shares without the tie-break " << share[0][0] << ", " << share[0][1] << "; with it " << share[1][0]
+                                              << ", " << share[1][1]);
+  INFO("mean distance of flat faces to their seed: without " << distance[0] << ", with " << distance[1]);
+  CHECK(std::min(share[0][0], share[0][1]) < 0.05);  // the paper's cost: one cluster floods
+  CHECK(std::min(share[1][0], share[1][1]) > 0.4);   // with the tie-break: about half each
+  CHECK(distance[1] < 0.8 * distance[0]);
+}
+
+TEST_CASE("salient clustering: the flat tie-break on fandisk", "[mesh]") {
+  auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("fandisk"));
+  if (!m.ok()) FAIL(m.error().message());
+  auto s = infolerp::compute_saliency(*m);
+  REQUIRE(s.ok());
+  // One growth from the same drawn seeds, for 8 user seeds: mean distance of the faces with
+  // zero saliency to their cluster's seed, averaged over the seeds.
+  double distance[2] = {0.0, 0.0};
+  for (int tie_break = 0; tie_break < 2; ++tie_break)
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      auto r = infolerp::salient_clustering(*m, s->saliency,
+                                            {.clusters = 10, .seed = seed, .max_iterations = 1, .flat_tie_break = tie_break == 1});
+      REQUIRE(r.ok());
+      distance[tie_break] += flat_distance_to_seed(*m, s->saliency, *r) / 8.0;
+    }
+  INFO("fandisk, mean distance of zero-saliency faces to their seed: without the tie-break " << distance[0]
+       << ", with " << distance[1]);
+  CHECK(distance[1] < distance[0]);
 }
 
 TEST_CASE("salient clustering: unreached components get their own cluster") {

@@ -61,8 +61,7 @@ inline void amplify_weights(std::span<double> values, double percentile, double 
 template <class M, class E = serial_executor>
 std::vector<double> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
                                          std::size_t grain = 1) {
-  const detail::point_grid grid =
-      detail::referenced_point_grid(m, detail::referenced_vertices(m), values, 2.0 * sigma);
+  const detail::vertex_points grid = detail::referenced_points(m, detail::referenced_vertices(m), values);
   const std::vector<double> avg = detail::exact_gaussian_averages(exec, grid, {sigma}, grain);
   std::vector<double> out(values.begin(), values.end());
   for (std::size_t k = 0; k < grid.id.size(); ++k) out[grid.id[k]] = avg[k];

@@ -11,10 +11,21 @@
 //        (λ_n − μ(n_c)·n_f') · |μ(S_c) − S_f'| · |S_c0 − S_f'| · |S_f − S_f'| · |x_f' − x_f|
 //      with μ(n_c) the cluster's area-weighted mean normal, μ(S_c) its mean face saliency and
 //      S_c0 its seed saliency, all as the cluster stands when f' is pushed.
+//      Eq. 2 is 0 whenever f and f' have equal saliency, so on a flat region (saliency exactly
+//      0 away from any feature) the paper's growth lets the first cluster to arrive take the
+//      whole region at no cost, however far it reaches. With flat_tie_break (the default, not in
+//      the paper) a step whose eq. 2 cost is 0 costs instead the mean cost per unit length of
+//      the non-zero steps pushed so far in this growth, times its length: flat regions are
+//      shared by distance. Every non-zero eq. 2 cost is kept as the paper gives it.
 //   3. Re-seeding: per cluster, a Dijkstra search from its border faces (faces next to another
 //      cluster or on a mesh boundary) inwards with cost |x_f' − x_f| · S_f' / max(S_c) (eq. 3);
 //      the new seed is the most salient vertex of the last face reached (a cluster without
 //      border keeps its seed).
+//   Seeds are distinct, and each seed has a face around it that no lower-numbered cluster's
+//   seed touches (a face around two seeds goes to the lower cluster): a vertex that fails this
+//   is skipped, in the draw for the next pool vertex, in re-seeding for the next most salient
+//   vertex of the last face, then of the faces reached before it. A seed's faces are not taken
+//   by another cluster's growth, so no seeded cluster ends empty.
 //   4. Repeat 2–3 until the seeds repeat a previous iteration's seeds (converged, or a cycle:
 //      the paper accepts any point on a cycle; we stop at the repeat) or max_iterations.
 // Face saliency S_f is the mean of its corners' vertex saliencies; x_f the centroid; n_f the
@@ -48,6 +59,7 @@ struct salient_clustering_options {
   double normal_weight = 1.0;     // λ_n in eq. (2) (>= 1 keeps every cost non-negative)
   std::uint64_t seed = 1;         // user seed for drawing seeds from the pool
   std::uint32_t max_iterations = 50;  // growth + re-seeding rounds at most
+  bool flat_tie_break = true;     // where eq. (2) costs 0, cost distance (see the top of this file)
 };
 
 struct salient_clusters {
@@ -131,18 +143,57 @@ struct clustering_workspace {
   std::vector<dist_entry> dist_heap;
   std::vector<double> dist;  // per face
   std::vector<std::uint32_t> best_cluster;  // growth: cluster of a face's best push so far (uses dist for its cost)
+  std::vector<char> seed_face;              // growth: a face around its cluster's seed vertex
+  std::vector<char> is_seed;                // per vertex: chosen as a seed (seed selection)
 };
+
+// Whether v can seed the next cluster, given the seeds already chosen (marked in is_seed): v is
+// not one of them and some face around v touches none of them. O(valence).
+template <class M>
+bool can_seed(const M& m, const face_data& fd, std::uint32_t v, const std::vector<char>& is_seed) {
+  if (is_seed[v] || fd.vf_offsets[v] == fd.vf_offsets[v + 1]) return false;
+  for (std::uint32_t k = fd.vf_offsets[v]; k < fd.vf_offsets[v + 1]; ++k) {
+    const glm::uvec3 c = mesh_triangle(m, fd.original[fd.vf[k]]);
+    if (!is_seed[c.x] && !is_seed[c.y] && !is_seed[c.z]) return true;
+  }
+  return false;
+}
+
+// The first vertex (by index) that can seed the next cluster, or invalid_id. O(V + T).
+template <class M>
+std::uint32_t first_free_seed(const M& m, const face_data& fd, const std::vector<char>& is_seed) {
+  for (std::size_t v = 0; v + 1 < fd.vf_offsets.size(); ++v)
+    if (can_seed(m, fd, static_cast<std::uint32_t>(v), is_seed)) return static_cast<std::uint32_t>(v);
+  return invalid_id;
+}
+
+// The most salient corner of internal face f that can seed the next cluster (ties: lower
+// index), or invalid_id.
+template <class M>
+std::uint32_t best_free_corner(const M& m, const face_data& fd, std::uint32_t f, std::span<const double> vsal,
+                               const std::vector<char>& is_seed) {
+  const glm::uvec3 tri = mesh_triangle(m, fd.original[f]);
+  std::uint32_t best = invalid_id;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t v = tri[k];
+    if (!can_seed(m, fd, v, is_seed)) continue;
+    if (best == invalid_id || vsal[v] > vsal[best] || (vsal[v] == vsal[best] && v < best)) best = v;
+  }
+  return best;
+}
 
 // One growth phase from the given seed vertices; label gets each internal face's cluster.
 // Queue order: (cost, −S_f', cluster, original face index).
 inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std::span<const std::uint32_t> seeds,
-                          double lambda_n, clustering_workspace& ws, std::vector<std::uint32_t>& label) {
+                          double lambda_n, bool flat_tie_break, clustering_workspace& ws,
+                          std::vector<std::uint32_t>& label) {
   using entry = clustering_workspace::grow_entry;
   const std::size_t nt = fd.area.size(), C = seeds.size();
   label.assign(nt, invalid_id);
   std::vector<glm::dvec3> nsum(C, glm::dvec3(0.0));
   std::vector<double> ssum(C, 0.0), s0(C);
   std::vector<std::uint32_t> nfaces(C, 0);
+  double positive_cost = 0.0, positive_length = 0.0;  // the non-zero eq. 2 steps pushed so far
   auto& heap = ws.grow_heap;
   heap.clear();
   const auto greater = [&](const entry& x, const entry& y) {
@@ -155,8 +206,9 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
   // same face would be popped after the better one, when the face is already labelled.
   ws.dist.assign(nt, std::numeric_limits<double>::infinity());
   ws.best_cluster.assign(nt, invalid_id);
+  ws.seed_face.assign(nt, 0);
   auto push = [&](double cost, std::uint32_t c, std::uint32_t g) {
-    if (cost > ws.dist[g] || (cost == ws.dist[g] && c >= ws.best_cluster[g])) return;
+    if (ws.seed_face[g] || cost > ws.dist[g] || (cost == ws.dist[g] && c >= ws.best_cluster[g])) return;
     ws.dist[g] = cost, ws.best_cluster[g] = c;
     heap.push_back({cost, -fd.hot[g].saliency, c, g});
     std::push_heap(heap.begin(), heap.end(), greater);
@@ -169,6 +221,8 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
       push(0.0, c, fd.vf[k]);
     }
   }
+  for (std::uint32_t c = 0; c < C; ++c)  // from now on no growth takes a seed's face
+    for (std::uint32_t k = fd.vf_offsets[seeds[c]]; k < fd.vf_offsets[seeds[c] + 1]; ++k) ws.seed_face[fd.vf[k]] = 1;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), greater);
     const entry top = heap.back();
@@ -187,16 +241,38 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
       const std::uint32_t g = fd.nb[k];
       if (label[g] != invalid_id) continue;
       const double sg = fd.hot[g].saliency;
-      const double step = (lambda_n - glm::dot(mean_n, fd.hot[g].normal)) *
-                          (std::abs(mean_s - sg) * std::abs(s0[c] - sg) * std::abs(fd.hot[f].saliency - sg)) *
-                          fd.step_length[k];
-      push(top.cost + std::max(step, 0.0), c, g);
+      double step = std::max(0.0, (lambda_n - glm::dot(mean_n, fd.hot[g].normal)) *
+                                      (std::abs(mean_s - sg) * std::abs(s0[c] - sg) * std::abs(fd.hot[f].saliency - sg)) *
+                                      fd.step_length[k]);
+      if (step > 0.0)
+        positive_cost += step, positive_length += fd.step_length[k];
+      else if (flat_tie_break && positive_length > 0.0)
+        step = positive_cost / positive_length * fd.step_length[k];
+      push(top.cost + step, c, g);
     }
   }
 }
 
+// After a re-seeding search (distances in ws.dist): the best free corner of cluster c's faces in
+// the reverse of the search's order (farthest first), or invalid_id. O(T log T); used only
+// when the last face's corners are all taken.
+template <class M>
+std::uint32_t latest_free_seed(const M& m, const face_data& fd, std::span<const std::uint32_t> label, std::uint32_t c,
+                               std::span<const double> vsal, const clustering_workspace& ws) {
+  std::vector<std::uint32_t> faces;
+  for (std::size_t f = 0; f < label.size(); ++f)
+    if (label[f] == c) faces.push_back(static_cast<std::uint32_t>(f));
+  std::sort(faces.begin(), faces.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return ws.dist[a] != ws.dist[b] ? ws.dist[a] > ws.dist[b] : fd.original[a] > fd.original[b];
+  });
+  for (std::uint32_t f : faces)
+    if (const std::uint32_t v = best_free_corner(m, fd, f, vsal, ws.is_seed); v != invalid_id) return v;
+  return invalid_id;
+}
+
 // Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
-// Dijkstra search from the cluster's border faces inward (ties: original face index).
+// Dijkstra search from the cluster's border faces inward (ties: original face index), among
+// the vertices that can seed it (can_seed; otherwise the faces reached before, latest first).
 template <class M>
 std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
                                   std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
@@ -240,13 +316,18 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
     }
   }
   std::vector<std::uint32_t> seeds(old_seeds.begin(), old_seeds.end());
+  ws.is_seed.assign(fd.vf_offsets.size() - 1, 0);
   for (std::size_t c = 0; c < C; ++c) {
-    if (last[c] == invalid_id) continue;  // no border: keep the seed
-    const glm::uvec3 tri = mesh_triangle(m, fd.original[last[c]]);
-    std::uint32_t best = tri.x;
-    for (int k = 1; k < 3; ++k)
-      if (vsal[tri[k]] > vsal[best] || (vsal[tri[k]] == vsal[best] && tri[k] < best)) best = tri[k];
-    seeds[c] = best;
+    std::uint32_t v = invalid_id;
+    if (last[c] == invalid_id)  // no border: keep the seed
+      v = can_seed(m, fd, old_seeds[c], ws.is_seed) ? old_seeds[c] : invalid_id;
+    else
+      v = best_free_corner(m, fd, last[c], vsal, ws.is_seed);
+    if (v == invalid_id) v = latest_free_seed(m, fd, label, static_cast<std::uint32_t>(c), vsal, ws);
+    if (v == invalid_id) v = first_free_seed(m, fd, ws.is_seed);
+    if (v == invalid_id) v = old_seeds[c];  // unreachable: a cluster's own seed always qualified
+    seeds[c] = v;
+    ws.is_seed[v] = 1;
   }
   return seeds;
 }
@@ -255,7 +336,8 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
 // Salient clustering of a mesh from per-vertex saliency (saliency/mesh_saliency.hpp).
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
 // non-finite or negative saliency (names the vertex); clusters == 0 or more clusters than the
-// pool or the triangle count can seed; pool_multiplier < 1; normal_weight < 1 (bad_parameter).
+// pool or the triangle count can seed, or more than the mesh has room for (each seed needs a
+// face no other seed touches); pool_multiplier < 1; normal_weight < 1 (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
 // reused by every round). Serial.
@@ -297,18 +379,29 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
   order.resize(pool_size);
   splitmix64 rng{opt.seed};
   std::vector<std::uint32_t> seeds(opt.clusters);
+  detail::clustering_workspace ws;
+  ws.is_seed.assign(nv, 0);
+  std::size_t drawn = 0;
   for (std::uint32_t c = 0; c < opt.clusters; ++c) {  // partial Fisher–Yates over the pool
-    const std::size_t k = c + static_cast<std::size_t>(rng.uniform(pool_size - c));
-    std::swap(order[c], order[k]);
-    seeds[c] = order[c];
+    seeds[c] = invalid_id;
+    while (seeds[c] == invalid_id && drawn < pool_size) {
+      const std::size_t k = drawn + static_cast<std::size_t>(rng.uniform(pool_size - drawn));
+      std::swap(order[drawn], order[k]);
+      if (detail::can_seed(m, fd, order[drawn], ws.is_seed)) seeds[c] = order[drawn];
+      ++drawn;
+    }
+    if (seeds[c] == invalid_id) seeds[c] = detail::first_free_seed(m, fd, ws.is_seed);
+    if (seeds[c] == invalid_id)
+      return make_error(errc::bad_parameter, no_element, "clusters ", opt.clusters,
+                        ": the mesh has no room for that many seeds, each with a face of its own");
+    ws.is_seed[seeds[c]] = 1;
   }
 
   salient_clusters out;
   std::vector<std::vector<std::uint32_t>> history;
-  detail::clustering_workspace ws;
   std::vector<std::uint32_t> label;  // per internal face
   for (;;) {
-    detail::grow_clusters(fd, saliency, seeds, opt.normal_weight, ws, label);
+    detail::grow_clusters(fd, saliency, seeds, opt.normal_weight, opt.flat_tie_break, ws, label);
     out.seeds = seeds;
     ++out.iterations;
     history.push_back(seeds);
