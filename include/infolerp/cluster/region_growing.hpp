@@ -98,16 +98,24 @@ struct region_growing_result {
   std::uint32_t cluster_count() const { return static_cast<std::uint32_t>(seeds.size()); }
 };
 
-namespace detail {
+// What one entry of a seed's JS column holds.
+enum class js_state : std::uint8_t {
+  unknown,  // not evaluated (yet)
+  value,    // js[c] is JS (or, with estimates, an estimate above Th: see js_entries)
+  bounded,  // JS <= Th − 2⁻²² by surely_within or the estimate, not evaluated (the float of
+            // the value would also be < Th: a bounded entry decides as the exact one would)
+  pending,  // transient inside one js_entries call (and growth's batch): to evaluate
+  copy,     // transient inside one js_entries call: to copy from the class's representative
+};
 
-// JS column entries that are not a value (JS is never negative): not evaluated (yet), and
-// "JS <= Th − 2⁻²² by the state's surely_within, value not evaluated" (so the float of the
-// value would also be < Th: a bounded entry decides as the exact one would).
-inline constexpr float js_unknown = -1.0f;
-inline constexpr float js_bounded = -3.0f;
-// Transient marks inside one js_entries call (and growth's batch): to evaluate, to copy.
-inline constexpr float js_pending = -2.0f;
-inline constexpr float js_copy = -4.0f;
+// One seed's JS to every class: the values and, in its own array, what each entry holds.
+struct js_column {
+  std::vector<float> js;
+  std::vector<js_state> state;
+  explicit js_column(std::size_t classes) : js(classes, 0.0f), state(classes, js_state::unknown) {}
+};
+
+namespace detail {
 
 template <class S>
 concept has_mutual_information_lower_bound = requires(const S& s, std::uint32_t a) {
@@ -167,28 +175,32 @@ bool similar(const S& s, std::uint32_t a, std::uint32_t b, double th, double err
 }
 
 // col[c] = JS(a, c) for the classes c listed in `which` (ascending, distinct), in parallel chunks
-// (each slot independent). With a threshold (>= 0), js_bounded where the state's
+// (each slot independent). With a threshold (>= 0), bounded where the state's
 // surely_within(a, c, threshold) holds, or, with the state's estimate(), where the estimate
 // puts JS at most threshold − err − 2⁻²²; where it puts JS above threshold + err + 2⁻²² the
 // entry is the estimate (a float above threshold, within err + 2⁻²⁴ of the exact entry) and
 // approx[c] (when given) is 1, else 0. Runs of consecutive classes go through the state's batch
 // divergences() when it has one.
 template <class S, class E>
-void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, std::span<float> col, std::size_t grain,
+void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> which, js_column& col, std::size_t grain,
                 E& exec, double threshold = -1.0, std::span<std::uint8_t> approx = {}) {
   const double err = threshold >= 0.0 && threshold < 1.0 ? estimate_error_of(s) : std::numeric_limits<double>::infinity();
   if (!approx.empty())
     for (std::uint32_t c : which) approx[c] = 0;
   // With the state's representative(): a class whose representative is also listed (and is
-  // neither a nor the class itself) is marked js_copy and copies its entry afterwards
+  // neither a nor the class itself) is marked copy and copies its entry afterwards
   // (bit-identical: same row). Representatives are never copies.
   if constexpr (has_representative<S>) {
-    for (std::uint32_t c : which) col[c] = js_pending;
+    for (std::uint32_t c : which) col.state[c] = js_state::pending;
     for (std::uint32_t c : which) {
       const std::uint32_t r = s.representative(c);
-      if (r != c && r != a && c != a && col[r] == js_pending) col[c] = js_copy;
+      if (r != c && r != a && c != a && col.state[r] == js_state::pending) col.state[c] = js_state::copy;
     }
   }
+  const auto set = [&](std::uint32_t c, float js) {
+    col.js[c] = js;
+    col.state[c] = js_state::value;
+  };
   for_each_chunk(exec, which.size(), grain, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e;) {
       const std::uint32_t c = which[i];
@@ -196,37 +208,46 @@ void js_entries(const S& s, std::uint32_t a, std::span<const std::uint32_t> whic
         constexpr std::size_t ahead = 4;  // about one memory latency of divergences
         if (i + ahead < e) s.prefetch(which[i + ahead]);
       }
-      if (col[c] == js_copy) {
+      if (col.state[c] == js_state::copy) {
         ++i;
         continue;
       }
       if (err < std::numeric_limits<double>::infinity()) {
         double est = 0.0;
         const int side = estimate_side(s, a, c, threshold, err, est);
-        col[c] = side < 0 ? js_bounded : side > 0 ? static_cast<float>(est) : static_cast<float>(s.divergence(a, c));
+        if (side < 0)
+          col.state[c] = js_state::bounded;
+        else
+          set(c, side > 0 ? static_cast<float>(est) : static_cast<float>(s.divergence(a, c)));
         if (side > 0 && !approx.empty()) approx[c] = 1;
         ++i;
         continue;
       }
       if constexpr (has_surely_within<S>) {
-        col[c] = threshold >= 0.0 && s.surely_within(a, c, threshold) ? js_bounded : static_cast<float>(s.divergence(a, c));
+        if (threshold >= 0.0 && s.surely_within(a, c, threshold))
+          col.state[c] = js_state::bounded;
+        else
+          set(c, static_cast<float>(s.divergence(a, c)));
         ++i;
-      } else if constexpr (requires { s.divergences(a, c, col.subspan(c, 1)); }) {
+      } else if constexpr (requires { s.divergences(a, c, std::span<float>(col.js).subspan(c, 1)); }) {
         std::size_t j = i + 1;
         while (j < e && which[j] == which[j - 1] + 1) ++j;
-        s.divergences(a, c, col.subspan(c, j - i));
+        s.divergences(a, c, std::span<float>(col.js).subspan(c, j - i));
+        std::fill(col.state.begin() + c, col.state.begin() + c + static_cast<std::ptrdiff_t>(j - i), js_state::value);
         i = j;
       } else {
-        col[c] = static_cast<float>(s.divergence(a, c));
+        set(c, static_cast<float>(s.divergence(a, c)));
         ++i;
       }
     }
   });
   if constexpr (has_representative<S>)
     for (std::uint32_t c : which)
-      if (col[c] == js_copy) {
-        col[c] = col[s.representative(c)];
-        if (!approx.empty()) approx[c] = approx[s.representative(c)];
+      if (col.state[c] == js_state::copy) {
+        const std::uint32_t r = s.representative(c);
+        col.js[c] = col.js[r];
+        col.state[c] = col.state[r];
+        if (!approx.empty()) approx[c] = approx[r];
       }
 }
 
@@ -254,18 +275,18 @@ inline void component_clusters(const element_graph& g, region_growing_result& r)
 
 // §3.2.2 seed selection. Returns the seed classes in order; `columns[k]` receives seed k's JS to
 // every class that was still a candidate (JS > Th to seeds 0..k-1) when seed k was chosen; the
-// other entries are js_unknown. Lazy: a class with JS <= Th to some seed can never become a
+// other entries are unknown. Lazy: a class with JS <= Th to some seed can never become a
 // seed, and its summed JS no longer matters, so it is not evaluated against later seeds (the
 // seeds are the same as with full columns). With the state's surely_within, entries the bound
-// decides (JS <= Th) are js_bounded and need no divergence: those classes are dropped anyway.
+// decides (JS <= Th) are bounded and need no divergence: those classes are dropped anyway.
 // Preconditions: 0 < threshold < 1, class_count() >= 1.
 // Complexity: U MI evaluations + one divergence (or estimate) per (seed, class still a
 // candidate), at most U per seed, plus with estimates one divergence per estimated entry of a
-// class that came within its error bound of the largest sum. Allocation U floats per seed
-// (and U bytes per seed with estimates).
+// class that came within its error bound of the largest sum. Allocation U floats and U
+// bytes (a js_column) per seed, and U bytes more per seed with estimates.
 template <class S, class E>
 std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_t grain, E& exec,
-                                        std::vector<std::vector<float>>& columns) {
+                                        std::vector<js_column>& columns) {
   static_assert(channel_state<S>);
   const std::size_t u = s.class_count();
   std::vector<double> mi(u);
@@ -308,9 +329,9 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
     if (r != c && slack[r] > 0.0) self(r, self);
     sum[c] = 0.0;
     for (std::size_t k = 0; k < seeds.size(); ++k) {
-      float& js = columns[k][c];
+      float& js = columns[k].js[c];
       if (approx[k][c]) {
-        js = r != c ? columns[k][r] : static_cast<float>(s.divergence(seeds[k], c));
+        js = r != c ? columns[k].js[r] : static_cast<float>(s.divergence(seeds[k], c));
         approx[k][c] = 0;
       }
       sum[c] += js;
@@ -319,16 +340,16 @@ std::vector<std::uint32_t> select_seeds(const S& s, double threshold, std::size_
   };
   for (;;) {
     seeds.push_back(next);
-    columns.emplace_back(u, detail::js_unknown);
+    columns.emplace_back(u);
     auto& col = columns.back();
     if (estimated) approx.emplace_back(u, 0);
-    detail::js_entries(s, next, candidates, std::span<float>(col), grain, exec, threshold,
+    detail::js_entries(s, next, candidates, col, grain, exec, threshold,
                        estimated ? std::span<std::uint8_t>(approx.back()) : std::span<std::uint8_t>());
     std::uint32_t best = invalid_id;
     std::size_t kept = 0;
     for (std::uint32_t c : candidates) {
-      sum[c] += col[c];
-      if (!(static_cast<double>(col[c]) > threshold)) continue;
+      sum[c] += col.js[c];  // a bounded entry's 0 adds to a sum no longer looked at
+      if (col.state[c] != js_state::value || !(static_cast<double>(col.js[c]) > threshold)) continue;
       if (estimated && approx.back()[c]) slack[c] += err + 0x1p-24;
       candidates[kept++] = c;
       if (best == invalid_id || sum[c] > sum[best]) best = c;
@@ -399,7 +420,7 @@ bool trivial_clusters(const S& s, const element_graph& g, double th, region_grow
 // Sets r.cluster_of (invalid_id where no seed arrived), r.seeds, r.parallel_seeds.
 template <class S, class E>
 void grow_rings(const S& s, const element_graph& g, std::span<const std::uint32_t> cls,
-                std::span<const std::uint32_t> seed_classes, std::vector<std::vector<float>>& columns, double th,
+                std::span<const std::uint32_t> seed_classes, std::vector<js_column>& columns, double th,
                 std::size_t grain, E& exec, region_growing_result& r) {
   const std::size_t m = cls.size(), k0 = seed_classes.size();
   r.parallel_seeds = static_cast<std::uint32_t>(k0);
@@ -424,26 +445,29 @@ void grow_rings(const S& s, const element_graph& g, std::span<const std::uint32_
       missing[k].clear();
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f))
-          if (label[n] == invalid_id && columns[k][cls[n]] == js_unknown) {
-            columns[k][cls[n]] = js_pending;
+          if (label[n] == invalid_id && columns[k].state[cls[n]] == js_state::unknown) {
+            columns[k].state[cls[n]] = js_state::pending;
             missing[k].push_back(cls[n]);
           }
       std::sort(missing[k].begin(), missing[k].end());
-      js_entries(s, seed_classes[k], missing[k], std::span<float>(columns[k]), grain, exec, th);
+      js_entries(s, seed_classes[k], missing[k], columns[k], grain, exec, th);
     }
-    // A js_bounded entry is similar; its value is needed only when a second seed claims the
+    // A bounded entry is similar; its value is needed only when a second seed claims the
     // same element in this ring (then both values are made exact, in this fixed order).
     auto exact = [&](std::uint32_t k, std::uint32_t c) {
-      float& js = columns[k][c];
-      if (js == js_bounded) js = static_cast<float>(s.divergence(seed_classes[k], c));
-      return js;
+      js_column& col = columns[k];
+      if (col.state[c] == js_state::bounded) {
+        col.js[c] = static_cast<float>(s.divergence(seed_classes[k], c));
+        col.state[c] = js_state::value;
+      }
+      return col.js[c];
     };
     for (std::uint32_t k = 0; k < k0; ++k)
       for (std::uint32_t f : frontier[k])
         for (std::uint32_t n : g.neighbours_of(f)) {
           if (label[n] != invalid_id) continue;
-          float js = columns[k][cls[n]];
-          if (js != js_bounded && !is_similar(js, th)) continue;
+          float js = columns[k].js[cls[n]];
+          if (columns[k].state[cls[n]] != js_state::bounded && !is_similar(js, th)) continue;
           if (best_k[n] == invalid_id) {
             touched.push_back(n);
           } else if (best_k[n] != k) {
@@ -592,7 +616,7 @@ result<region_growing_result> grow_regions(const S& s, const element_graph& g, c
   const std::size_t m = s.element_count();
   std::vector<std::uint32_t> cls(m);
   for (std::uint32_t e = 0; e < m; ++e) cls[e] = s.class_of(e);
-  std::vector<std::vector<float>> columns;
+  std::vector<js_column> columns;
   const std::vector<std::uint32_t> seed_classes = select_seeds(s, o.threshold, o.grain, exec, columns);  // §3.2.2
   detail::grow_rings(s, g, cls, seed_classes, columns, o.threshold, o.grain, exec, r);                 // §3.2.3
   columns = {};
