@@ -724,11 +724,13 @@ struct visibility_channel {
   void prepare_images(const M& m, const visibility_setup& su, const T& tr, E& exec, prepared_visibility_channel& p) const {
     const std::size_t nt = mesh_triangle_count(m), nv = su.viewpoints.size(), per_wave = 8;
     const bounding_box box = mesh_bounds(m);
+    std::vector<glm::dvec3> points(mesh_vertex_count(m));
+    for (std::size_t i = 0; i < points.size(); ++i) points[i] = glm::dvec3(mesh_position(m, i));
     for (std::size_t w0 = 0; w0 < nv; w0 += per_wave) {
       const std::size_t w1 = std::min(nv, w0 + per_wave);
       exec.parallel_for(w1 - w0, 1, [&](std::size_t vb, std::size_t ve) {
         for (std::size_t v = w0 + vb; v < w0 + ve; ++v)
-          detail::image_occlusion_ratios(m, tr, su.viewpoints[v], box, image_resolution, image_min_pixels, su.samples,
+          detail::image_occlusion_ratios(m, tr, su.viewpoints[v], box, points, image_resolution, image_min_pixels, su.samples,
                                          su.offset, 255.0, p.visible.data() + v, nv);
       });
       if (progress) progress(nt * w1 / nv, nt);

@@ -8,8 +8,8 @@
 // on where the camera looks: u_v(t) by Van Oosterom and Strackee's formula, a_v(t) as the sum of
 // the solid angles of the pixels whose primary ray first hits t (pixel (x, y) of a pinhole image
 // at focal distance 1 subtends dA / (1 + x² + y²)^{3/2}). OR = min(1, a/u).
-// The camera at v looks at the mesh's bounding-box centre; its square field of view holds the
-// box (half-angle at most 80°).
+// The camera at v looks at the mesh's bounding-box centre; its square field of view is the
+// tightest that holds every vertex (half-angle at most 80°), so the mesh fills the image.
 // Triangles the image cannot measure fall back to the n² sample rays of the ray method (OR = free
 // samples / n², as visibility_channel counts them):
 //   - a corner outside the field of view or behind the camera,
@@ -43,22 +43,22 @@ inline double triangle_solid_angle(glm::dvec3 e, const triangle_corners& t) {
   return 2.0 * std::atan2(num, den);
 }
 
-// A pinhole camera at `eye` looking at a box's centre with a square field of view, half-width
-// `half` on the image plane at distance 1.
+// A pinhole camera at `eye` looking at `target` with a square field of view, half-width `half` on
+// the image plane at distance 1, the tightest holding `points` (at most tan 80°). O(points).
 struct viewpoint_camera {
   glm::dvec3 eye, forward, right, up;
   double half = 1.0;
   static constexpr double max_half = 5.6712818196177;  // tan 80°
 
-  static viewpoint_camera looking_at(glm::dvec3 eye, const bounding_box& box) {
-    viewpoint_camera c{eye, glm::normalize(box.center() - eye), {}, {}, 0.0};
+  static viewpoint_camera looking_at(glm::dvec3 eye, glm::dvec3 target, std::span<const glm::dvec3> points) {
+    viewpoint_camera c{eye, glm::normalize(target - eye), {}, {}, 0.0};
     const glm::dvec3 helper = std::abs(c.forward.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
     c.right = glm::normalize(glm::cross(c.forward, helper));
     c.up = glm::cross(c.right, c.forward);
-    for (int k = 0; k < 8; ++k) {
-      const glm::dvec3 q(k & 1 ? box.hi.x : box.lo.x, k & 2 ? box.hi.y : box.lo.y, k & 4 ? box.hi.z : box.lo.z);
+    for (const glm::dvec3& q : points) {
       const glm::dvec3 p = c.project(q);
       c.half = p.z > 0.0 ? std::max({c.half, std::abs(p.x), std::abs(p.y)}) : max_half;
+      if (c.half >= max_half) break;
     }
     c.half = std::min(c.half, max_half) * (1.0 + 1e-6);
     return c;
@@ -74,15 +74,17 @@ struct viewpoint_camera {
 namespace detail {
 
 // OR(t, v) of every triangle of m toward one viewpoint `eye`, written as round(OR · scale) to
-// column[t · stride] (scale <= 255). `samples`, `offset`: the sample pattern of the fallback rays.
-// Complexity: R² primary rays + n² occlusion rays per fallback triangle + O(T).
+// column[t · stride] (scale <= 255). `points`: m's vertices. `samples`, `offset`: the sample
+// pattern of the fallback rays.
+// Complexity: R² primary rays + n² occlusion rays per fallback triangle + O(T + V).
 // Allocation: T doubles and T bytes, and batches of at most 4096 rays.
 template <class M, class T>
-void image_occlusion_ratios(const M& m, const T& tracer, glm::dvec3 eye, const bounding_box& box, std::uint32_t resolution,
+void image_occlusion_ratios(const M& m, const T& tracer, glm::dvec3 eye, const bounding_box& box,
+                            std::span<const glm::dvec3> points, std::uint32_t resolution,
                             double min_pixels, std::span<const glm::dvec2> samples, double offset, double scale,
                             std::uint8_t* column, std::size_t stride) {
   const std::size_t nt = mesh_triangle_count(m);
-  const viewpoint_camera cam = viewpoint_camera::looking_at(eye, box);
+  const viewpoint_camera cam = viewpoint_camera::looking_at(eye, box.center(), points);
   // a_v(t): the solid angle of the pixels whose first hit is t, image traced in 16×16 tiles.
   std::vector<double> seen(nt, 0.0);
   const double pixel = 2.0 * cam.half / resolution;
