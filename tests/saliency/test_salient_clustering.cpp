@@ -1,5 +1,6 @@
-// saliency/salient_clustering.hpp: partition invariants, determinism, unreached components,
-// the PRNG's reference sequence, and eq. (4) on a hand-checked case.
+// saliency/salient_clustering.hpp: partition invariants, determinism, distinct seeds and no
+// empty cluster, the flat tie-break (a plane, fandisk), unreached components, the PRNG's
+// reference sequence, and eq. (4) on a hand-checked case.
 #include <catch2/catch.hpp>
 
 #include <algorithm>

@@ -206,15 +206,15 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
   const std::size_t L = t.r2.size();
   const double r2max = t.r2[L - 1];
   const double *px_all = g.row(0), *py_all = g.row(1), *pz_all = g.row(2), *pc_all = g.row(3);
-  std::vector<column_ref> near;
+  std::vector<column_ref> nearby;
   for (std::uint32_t tc = 0; tc < tile.count; ++tc) {
     const std::uint32_t own = tile.cols[tc];
     columns_after(g, static_cast<std::uint32_t>(g.col_key[own] >> 32), static_cast<std::uint32_t>(g.col_key[own]), span,
-                  near);
+                  nearby);
       for (std::size_t i = g.col_start[own]; i < g.col_start[own + 1]; ++i) {
         const double xi = px_all[i], yi = py_all[i], zi = pz_all[i], ci = pc_all[i];
         V acc_n[LC][G] = {}, acc_d[LC][G] = {}, w[LC][G];  // index s: σ number L − 1 − s
-        for (const column_ref& nb : near) {
+        for (const column_ref& nb : nearby) {
             const std::size_t q = nb.q;
             const std::uint32_t ax = nb.ax, ay = nb.ay;
             const double lx = g.x0 + ax * g.h, ly = g.y0 + ay * g.h;

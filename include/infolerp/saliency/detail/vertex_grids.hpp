@@ -144,11 +144,11 @@ struct column_ref {
 // The occupied columns that a point of column (cx, cy) meets: its own, the later ones in its
 // x, and those up to span later in x and span either side in y, in (x, y) order.
 inline void columns_after(const column_grid& g, std::uint32_t cx, std::uint32_t cy, std::uint32_t span,
-                          std::vector<column_ref>& near) {
-  near.clear();
+                          std::vector<column_ref>& nearby) {
+  nearby.clear();
   for (std::uint32_t ax = cx; ax <= cx + span; ++ax)
     for (std::uint32_t ay = ax == cx ? cy : (cy > span ? cy - span : 0); ay <= cy + span; ++ay)
-      if (const std::size_t q = g.find(ax, ay); q < g.col_key.size()) near.push_back({q, ax, ay});
+      if (const std::size_t q = g.find(ax, ay); q < g.col_key.size()) nearby.push_back({q, ax, ay});
 }
 
 // The tiles of span × span column positions that hold points, each with its phase
