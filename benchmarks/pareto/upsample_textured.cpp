@@ -9,7 +9,9 @@
 // built-in scene alone gives the second set of rows. Clusters: the demo's feature clustering
 // cut at UV seams (cluster/uv_seams.hpp). Every repetition renders each row once, in the same
 // order (interleaved), so the rows share the machine's load; times are the min and the median
-// over the repetitions (wall time, all threads). Rows:
+// over the repetitions (wall time, and process CPU time of all threads: run with
+// OMP_WAIT_POLICY=passive), speed-ups the ratio of the mins and the median of the
+// per-repetition ratios. Rows:
 //   per_pixel        every pixel evaluated and shaded by the ready source (the reference image)
 //   per_pixel_hand   the same with the hand-written demo source (support/demo_upsample.hpp)
 //   ibuffer          the ready source, K passes
@@ -22,6 +24,7 @@
 // cropped to at most 272x272 pixels at the asset's centre.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -55,16 +58,25 @@ struct textured_options {
 struct row {
   std::string method, setting;
   std::function<double(sup::image&)> render;
-  std::vector<double> seconds;
+  std::vector<double> seconds;  // wall time per repetition
+  std::vector<double> cpu{};      // process CPU time per repetition (all threads)
   double evaluated = 1.0, psnr = 0.0, ssim = 0.0;
   sup::image img{};
-  double min() const { return *std::min_element(seconds.begin(), seconds.end()); }
-  double median() const {
-    auto s = seconds;
-    std::sort(s.begin(), s.end());
-    return s.size() % 2 == 1 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2 - 1] + s[s.size() / 2]);
+  static double min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+  static double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 == 1 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
   }
+  double min() const { return min(seconds); }
+  double median() const { return median(seconds); }
 };
+
+// The median over repetitions of num's time / den's time in the same repetition.
+double median_ratio(const std::vector<double>& num, const std::vector<double>& den) {
+  std::vector<double> r;
+  for (std::size_t k = 0; k < num.size(); ++k) r.push_back(num[k] / den[k]);
+  return row::median(r);
+}
 
 template <class Source>
 std::function<double(sup::image&)> per_pixel(const Source& src, int threads) {
@@ -102,6 +114,14 @@ std::function<double(sup::image&)> ibuffer(const Source& src, std::uint32_t pass
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
+// CPU time of the whole process: less sensitive than wall time to the other processes of a
+// shared machine (with OMP_WAIT_POLICY=passive, so that idle OpenMP workers do not spin).
+double cpu_now() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 std::vector<float> luma(const sup::image& img) {
   std::vector<float> l(img.pixels.size());
   for (std::size_t i = 0; i < l.size(); ++i) l[i] = sup::display_luma(img.pixels[i]);
@@ -113,9 +133,10 @@ void measure(std::vector<row>& rows, int repeat, int w, int h) {
   for (auto& r : rows) r.img = sup::image(w, h);
   for (int rep = 0; rep < repeat; ++rep)
     for (auto& r : rows) {
-      const double t0 = now();
+      const double t0 = now(), c0 = cpu_now();
       r.evaluated = r.render(r.img);
       r.seconds.push_back(now() - t0);
+      r.cpu.push_back(cpu_now() - c0);
     }
   const auto ref_luma = luma(rows[0].img);
   for (auto& r : rows) {
@@ -125,18 +146,23 @@ void measure(std::vector<row>& rows, int repeat, int w, int h) {
 }
 
 void print(const std::string& scene, const std::vector<row>& rows) {
-  std::printf("\n%s\n%-16s %-34s %9s %9s %8s %8s %8s %8s %8s\n", scene.c_str(), "method", "setting", "min s", "median s",
-              "x(min)", "x(med)", "eval", "PSNR", "SSIM");
+  // Speed-ups: ratio of the mins, and the median over repetitions of the per-repetition ratio
+  // (the rows of one repetition ran moments apart, under about the same load); wall and CPU time.
+  std::printf("\n%s\n%-19s %-20s %7s %7s %7s %7s %7s %7s %7s %6s %7s %7s\n", scene.c_str(), "method", "setting", "wall min",
+              "wall med", "x(min)", "x(rep)", "cpu min", "x(min)", "x(rep)", "eval", "PSNR", "SSIM");
+  const row& ref = rows[0];
   for (const auto& r : rows)
-    std::printf("%-16s %-34s %9.3f %9.3f %8.2f %8.2f %8.4f %8.2f %8.5f\n", r.method.c_str(), r.setting.c_str(), r.min(),
-                r.median(), rows[0].min() / r.min(), rows[0].median() / r.median(), r.evaluated, std::min(r.psnr, 99.0), r.ssim);
+    std::printf("%-19s %-20s %7.3f %7.3f %7.2f %7.2f %7.3f %7.2f %7.2f %6.4f %7.2f %7.5f\n", r.method.c_str(), r.setting.c_str(),
+                r.min(), r.median(), ref.min() / r.min(), median_ratio(ref.seconds, r.seconds), row::min(r.cpu),
+                row::min(ref.cpu) / row::min(r.cpu), median_ratio(ref.cpu, r.cpu), r.evaluated, std::min(r.psnr, 99.0), r.ssim);
   // The ready source against the hand-written one, per frame, in each setting they share.
   for (const auto& hand : rows) {
     if (!hand.method.ends_with("_hand")) continue;
     for (const auto& ready : rows)
       if (ready.method + "_hand" == hand.method && ready.setting == hand.setting)
-        std::printf("ready / hand-written, %s %s: %.3f (min) %.3f (median)\n", ready.method.c_str(), ready.setting.c_str(),
-                    ready.min() / hand.min(), ready.median() / hand.median());
+        std::printf("ready / hand-written, %s %s: wall %.3f (ratio of mins) %.3f (median of per-repetition ratios), "
+                    "cpu %.3f %.3f\n", ready.method.c_str(), ready.setting.c_str(), ready.min() / hand.min(),
+                    median_ratio(ready.seconds, hand.seconds), row::min(ready.cpu) / row::min(hand.cpu), median_ratio(ready.cpu, hand.cpu));
   }
   std::fflush(stdout);
 }
@@ -246,8 +272,8 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
   hand_refine.primary_sun = &primary_sun;
 
   std::vector<row> rows;
-  rows.push_back({"per_pixel", "every pixel evaluated", per_pixel(*ready, o.threads), {}});
-  rows.push_back({"per_pixel_hand", "every pixel evaluated", per_pixel(hand, o.threads), {}});
+  rows.push_back({"per_pixel", "all pixels", per_pixel(*ready, o.threads), {}});
+  rows.push_back({"per_pixel_hand", "all pixels", per_pixel(hand, o.threads), {}});
   for (std::uint32_t p : {3u, 4u, 5u})
     rows.push_back({"ibuffer", std::to_string(p) + " passes", ibuffer(*ready, p, 2, o.threads, o.width, o.height), {}});
   for (std::uint32_t p : {4u, 5u, 6u})

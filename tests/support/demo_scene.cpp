@@ -5,9 +5,9 @@
 #include <string_view>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/validate.hpp"
-#include "infolerp/mesh/adaptors.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
