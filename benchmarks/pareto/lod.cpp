@@ -1,6 +1,6 @@
 // infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A] [--percentile P]
 //                     [--only-given] [--no-frames]
-// (--amplification, --percentile: the weighting map's λ and α, defaults 100 and 30; --only-given:
+// (--amplification, --percentile: the weighting map's λ and α, defaults 1 and 30; --only-given:
 // only the --mesh meshes; --no-frames: no frame rows)
 //
 // View-dependent multiresolution rendering (salient-clustering paper §III.C, §IV) against

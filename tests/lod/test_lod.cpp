@@ -110,8 +110,9 @@ TEST_CASE("weighting map: amplification and smoothing on hand-made maps", "[lod]
   REQUIRE(plain.ok());
   REQUIRE(eq4.ok());
   CHECK(*plain == *eq4);
-  // Defaults: every corner is its smoothed eq. 4 value, ×100 at or above the 30th percentile.
-  auto full = weighting_map(m, sal, cl, 8);
+  // Lee's amplification: every corner is its smoothed eq. 4 value, ×100 at or above the 30th
+  // percentile.
+  auto full = weighting_map(m, sal, cl, 8, {.amplify_percentile = 30.0, .amplification = 100.0});
   REQUIRE(full.ok());
   const std::vector<double> sm = smooth_vertex_values(m, std::span<const double>(sal), 3.0 * 0.003 * mesh_bounds(m).diagonal());
   auto local = cluster_localized_saliency(m, std::span<const double>(sm), cl, 8);

@@ -7,7 +7,13 @@
 // mesh-boundary edges add a perpendicular plane (boundary_weight × squared edge length) to
 // both ends. Contractions are half-edge collapses u → v (u is removed, v keeps its position),
 // so every level of detail indexes the original vertices and the per-view pass only remaps
-// indices. Cost of u → v: (Q_u + Q_v)(p_v); pairs are ordered globally over the whole mesh
+// indices; a contraction adds Q_u to Q_v. Cost of u → v: Q_u(p_v) / A_u, A_u the triangle area
+// Q_u has gathered (without the saliency weights): the area-weighted mean of the weighted
+// squared distances from p_v to the planes u stands for, so that the saliency weight, not the
+// area already gathered, decides what goes first (Q_v(p_v) is v's own error so far, the same
+// for every contraction into v, and is left out; meshoptimizer ranks its collapses the same
+// way, and measured on bunny00, armadillo and refined_elephant the unnormalised sum
+// (Q_u + Q_v)(p_v) left larger distances at every triangle count). Pairs are ordered globally over the whole mesh
 // (connectivity across cluster borders is kept) by (cost, u, v): a binary heap holds each
 // vertex's cheapest contraction, updated in place when a contraction changes the vertex's
 // quadric or neighbours; a vertex whose cheapest contraction is refused is queued with its
@@ -78,7 +84,7 @@ struct contraction_hierarchy {
   // Per contraction, in global order.
   std::vector<std::uint32_t> removed, target, parent, owner;
   std::vector<std::uint8_t> faces_removed;  // triangles the contraction removes (1 on a boundary edge, 2 inside)
-  std::vector<float> error;                 // its weighted quadric cost (Q_u + Q_v)(p_v)
+  std::vector<float> error;                 // its cost Q_u(p_v) / A_u (see the top of the file)
   // Per vertex: the order of the contraction removing it, or invalid_id.
   std::vector<std::uint32_t> removal_order;
   // Per cluster (CSR): owned contractions ascending.
@@ -110,8 +116,8 @@ struct contraction_hierarchy {
 
 namespace detail {
 
-struct quadric {  // symmetric 4×4: a (xx xy xz yy yz zz), b (x y z), c
-  double a[6] = {}, b[3] = {}, c = 0.0;
+struct quadric {  // symmetric 4×4: a (xx xy xz yy yz zz), b (x y z), c; area: triangle area gathered
+  double a[6] = {}, b[3] = {}, c = 0.0, area = 0.0;
   void add_plane(const glm::dvec3& n, double d, double w) {
     a[0] += w * n.x * n.x, a[1] += w * n.x * n.y, a[2] += w * n.x * n.z;
     a[3] += w * n.y * n.y, a[4] += w * n.y * n.z, a[5] += w * n.z * n.z;
@@ -121,6 +127,7 @@ struct quadric {  // symmetric 4×4: a (xx xy xz yy yz zz), b (x y z), c
     for (int k = 0; k < 6; ++k) a[k] += q.a[k];
     for (int k = 0; k < 3; ++k) b[k] += q.b[k];
     c += q.c;
+    area += q.area;
     return *this;
   }
   [[nodiscard]] double eval(const glm::dvec3& p) const {
@@ -130,10 +137,9 @@ struct quadric {  // symmetric 4×4: a (xx xy xz yy yz zz), b (x y z), c
   }
 };
 
-inline double sum_eval(const quadric& q0, const quadric& q1, const glm::dvec3& p) {
-  quadric q = q0;
-  q += q1;
-  return q.eval(p);
+// The cost of moving a vertex with quadric q to p: q(p) per unit of gathered area.
+inline double collapse_cost(const quadric& q, const glm::dvec3& p) {
+  return q.area > 0.0 ? q.eval(p) / q.area : q.eval(p);
 }
 
 // Vertex u's cheapest contraction u → v.
@@ -391,7 +397,10 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     if (!(len > 0.0)) continue;
     const glm::dvec3 n = n2 / len;
     const double d = -glm::dot(n, p0), area = 0.5 * len;
-    for (int j = 0; j < 3; ++j) cm.q[f[j]].add_plane(n, d, area * weights[3 * t + static_cast<std::size_t>(j)]);
+    for (int j = 0; j < 3; ++j) {
+      cm.q[f[j]].add_plane(n, d, area * weights[3 * t + static_cast<std::size_t>(j)]);
+      cm.q[f[j]].area += area;
+    }
   }
   // Boundary planes.
   for (std::size_t e = 0; e < topo->edge_count(); ++e) {
@@ -424,18 +433,20 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   std::vector<std::pair<std::uint32_t, std::uint32_t>> dep_scratch;  // (cluster, order) of dependencies
 
   // One heap entry per vertex: its cheapest contraction (the global minimum over pairs is the
-  // minimum over vertices). A contraction u → v changes the costs of v and of v's new
-  // neighbours, whose entries are recomputed.
+  // minimum over vertices). A contraction u → v changes the costs of v (Q_v grew) and the
+  // candidates of v's neighbours (u is gone, v may be new), whose entries are updated.
   detail::vertex_heap heap;
   heap.reset(nv);
   std::vector<std::uint32_t> candidates;
   std::vector<std::pair<double, std::uint32_t>> ranked;
-  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::sum_eval(cm.q[u], cm.q[v], cm.pos[v]); };
+  std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
+  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.pos[v]); };
   auto set_best = [&](std::uint32_t u) {
     cm.ring(u, candidates);
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
     for (std::uint32_t v : candidates)
       if (const detail::collapse_entry e{cost(u, v), u, v}; e < best) best = e;
+    fallback[u] = 0;
     if (best.v != invalid_id) heap.set(best);
     else heap.erase(u);
   };
@@ -463,7 +474,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       if (v != failed) ranked.push_back({cost(u, v), v});
     std::sort(ranked.begin(), ranked.end());
     for (const auto& [c, v] : ranked)
-      if (valid(u, v)) return heap.set({c, u, v});
+      if (valid(u, v)) return heap.set({c, u, v}), void(fallback[u] = 1);
     heap.erase(u);
   };
   while (live > floor_count) {
@@ -511,11 +522,12 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     progress_since_fill = true;
     cm.ring(e.v, cm.ring_v);
     set_best(e.v);
-    // A neighbour x of v: only x → v changed (Q_v grew) or vanished (x → u); an entry aiming
-    // elsewhere stays exact unless x → v now beats it.
+    // A neighbour x of v: x → u vanished and x → v may be new (its cost depends on Q_x and p_v
+    // only); an entry not aiming at u stays exact unless x → v beats it. A vertex without an
+    // entry or with a fallback one is ranked anew: its refused contractions may pass now.
     for (std::uint32_t x : cm.ring_v) {
       const detail::collapse_entry* old = heap.find(x);
-      if (!old || old->v == e.u || old->v == e.v) {
+      if (!old || fallback[x] || old->v == e.u) {
         set_best(x);
       } else if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) {
         heap.set(to_v);

@@ -11,8 +11,13 @@
 //      is linear, so this equals smoothing the localised map, except that the cluster's min, max
 //      and mean are those of the smoothed values: the map stays within [μ, μ + 1] per cluster;
 //   3. amplification: A(x) = λ·x for x ≥ α, x otherwise, with α the amplify_percentile-th
-//      percentile of the corner values (nearest rank) and λ = amplification (Lee's 30th
-//      percentile and λ = 100 by default).
+//      percentile of the corner values (nearest rank) and λ = amplification. Lee et al. use the
+//      30th percentile and λ = 100; the default here is λ = 1 (no amplification): with the
+//      area-normalised collapse cost of contraction_hierarchy.hpp, the map of steps 1–2 alone
+//      already left a smaller saliency-weighted distance than meshoptimizer on bunny00,
+//      armadillo and refined_elephant (35% to 1% of the triangles), and larger λ traded it for
+//      a larger Hausdorff distance (infolerp_pareto lod --amplification λ measures it;
+//      benchmarks/NOTES.md has the figures).
 // The result holds one weight per triangle corner (3 per triangle, corner j of triangle t at
 // 3t + j): a vertex on a cluster border weights each of its triangles' quadrics with that
 // triangle's cluster's value.
@@ -37,7 +42,7 @@ struct weighting_map_options {
   double epsilon = 0.003;           // ε as a fraction of the bounding-box diagonal
   double smoothing_scale = 3.0;     // σ_s = smoothing_scale · ε; 0 skips the smoothing
   double amplify_percentile = 30.0;  // α: corner values at or above this percentile are amplified, in [0, 100]
-  double amplification = 100.0;     // λ >= 1; 1 skips the amplification
+  double amplification = 1.0;       // λ >= 1; 1 skips the amplification (Lee et al.: 100)
   std::size_t grain = 1;            // tiles of the Gaussian kernel per parallel task
 };
 
