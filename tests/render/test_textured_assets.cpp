@@ -210,6 +210,38 @@ TEST_CASE("demo scene with assets: one textured object per material; untextured 
   CHECK_THAT(std::string(broken.error().message()), Catch::Contains("asset_1.png"));
 }
 
+TEST_CASE("shading an image texture takes the mip level of the pixel's footprint", "[assets][texture]") {
+  const auto a = small_asset();
+  const auto path = support::write_obj(a, scratch("mips"), "asset");
+  INFO(why(path));
+  REQUIRE(path);
+  auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path}});
+  INFO(why(scene));
+  REQUIRE(scene);
+  const std::uint32_t g = 4;  // material 0's object
+  const auto& mat = scene->objects[g].mat;
+  REQUIRE(mat.texture == support::texture_kind::image);
+  // An unshadowed, unoccluded record lit by the ambient term only: colour = albedo x ambient.
+  support::shading_inputs in;
+  in.geometry = g;
+  in.normal = {0.0f, 0.0f, 1.0f};
+  in.ao = 1.0f;
+  in.uv = {0.1234f, 0.4321f};
+  const float angle = support::pixel_angle(scene->view, 1025);
+  const support::reference_shader finest(*scene), mipped(*scene, {.pixel_angle = angle});
+  for (float distance : {0.5f, 8.0f, 200.0f}) {
+    in.position = scene->view.eye + glm::vec3(0.0f, 0.0f, distance);
+    const float lod = std::log2(distance * angle * mat.texels_per_unit);
+    const glm::vec3 want = support::albedo(mat, in.uv, lod) * scene->ambient;
+    CHECK(glm::distance(mipped.shade(in), want) < 1e-5f);
+    CHECK(glm::distance(finest.shade(in), mat.image->bilinear(in.uv, 0) * scene->ambient) < 1e-5f);
+  }
+  // Far away the footprint covers the whole 32² texture: its mean colour.
+  in.position = scene->view.eye + glm::vec3(0.0f, 0.0f, 1e6f);
+  const auto& top = mat.image->level(mat.image->level_count() - 1);
+  CHECK(glm::distance(mipped.shade(in), top.at(0, 0) * scene->ambient) < 1e-5f);
+}
+
 namespace {
 
 // The ready source with every sample's texcoords replaced by its chart, as a point on the unit
