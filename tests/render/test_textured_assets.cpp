@@ -28,13 +28,18 @@ const support::embree_device& device() {
   return d;
 }
 
-// A fresh directory of this process for the files a test writes.
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("infolerp_textured_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh directory of this process for the files a test writes, removed with the object.
+struct scratch {
+  fs::path path;
+  explicit scratch(const std::string& name)
+      : path(fs::temp_directory_path() / ("infolerp_textured_" + std::to_string(::getpid())) / name) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~scratch() { fs::remove_all(path.parent_path()); }
+  scratch(const scratch&) = delete;
+  scratch& operator=(const scratch&) = delete;
+};
 
 support::textured_asset small_asset() { return support::make_textured_asset({.cells = 4, .materials = 3, .texture_size = 32}); }
 
@@ -113,7 +118,8 @@ TEST_CASE("texture: bilinear at texel centres, mip levels average, trilinear ble
 
 TEST_CASE("textured OBJ + MTL + PNG written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_obj(a, scratch("obj"), "asset");
+  const scratch dir("obj");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -124,7 +130,8 @@ TEST_CASE("textured OBJ + MTL + PNG written and loaded back", "[assets]") {
 
 TEST_CASE("textured glTF 2.0 written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_gltf(a, scratch("gltf"), "asset");
+  const scratch dir("gltf");
+  const auto path = support::write_gltf(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -135,11 +142,11 @@ TEST_CASE("textured glTF 2.0 written and loaded back", "[assets]") {
 
 TEST_CASE("textured GLB (images embedded) written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto dir = scratch("glb");
-  const auto path = support::write_glb(a, dir, "asset");
+  const scratch dir("glb");
+  const auto path = support::write_glb(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
-  for (unsigned k = 0; k < a.materials; ++k) fs::remove(dir / ("asset_" + std::to_string(k) + ".png"));  // only the embedded copies
+  for (unsigned k = 0; k < a.materials; ++k) fs::remove(dir.path / ("asset_" + std::to_string(k) + ".png"));  // only the embedded copies
   const auto parts = support::load_textured_mesh(*path);
   INFO(why(parts));
   REQUIRE(parts);
@@ -148,7 +155,8 @@ TEST_CASE("textured GLB (images embedded) written and loaded back", "[assets]") 
 
 TEST_CASE("textured PLY written and loaded back: texcoords and the TextureFile comment", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_ply(a, scratch("ply"), "asset");
+  const scratch dir("ply");
+  const auto path = support::write_ply(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -185,7 +193,8 @@ TEST_CASE("the generated asset: over 50k triangles, six charts, three materials"
 
 TEST_CASE("demo scene with assets: one textured object per material; untextured meshes say what is skipped", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_obj(a, scratch("scene"), "asset");
+  const scratch dir("scene");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path, support::cgal_mesh("fandisk")}});
@@ -212,7 +221,8 @@ TEST_CASE("demo scene with assets: one textured object per material; untextured 
 
 TEST_CASE("shading an image texture takes the mip level of the pixel's footprint", "[assets][texture]") {
   const auto a = small_asset();
-  const auto path = support::write_obj(a, scratch("mips"), "asset");
+  const scratch dir("mips");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path}});
@@ -297,7 +307,8 @@ std::pair<std::size_t, std::size_t> mixed_chart_pixels(const support::reference_
 
 TEST_CASE("UV seams: chart ids rendered through the upsampler never mix two charts", "[assets][seams]") {
   const auto a = support::make_textured_asset();
-  const auto path = support::write_obj(a, scratch("seams"), "asset");
+  const scratch dir("seams");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path}, .mesh_size = 4.0f});
