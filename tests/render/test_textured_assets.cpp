@@ -28,13 +28,18 @@ const support::embree_device& device() {
   return d;
 }
 
-// A fresh directory of this process for the files a test writes.
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("infolerp_textured_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh directory of this process for the files a test writes, removed with the object.
+struct scratch {
+  fs::path path;
+  explicit scratch(const std::string& name)
+      : path(fs::temp_directory_path() / ("infolerp_textured_" + std::to_string(::getpid())) / name) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~scratch() { fs::remove_all(path.parent_path()); }
+  scratch(const scratch&) = delete;
+  scratch& operator=(const scratch&) = delete;
+};
 
 support::textured_asset small_asset() { return support::make_textured_asset({.cells = 4, .materials = 3, .texture_size = 32}); }
 
@@ -113,7 +118,8 @@ TEST_CASE("texture: bilinear at texel centres, mip levels average, trilinear ble
 
 TEST_CASE("textured OBJ + MTL + PNG written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_obj(a, scratch("obj"), "asset");
+  const scratch dir("obj");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -124,7 +130,8 @@ TEST_CASE("textured OBJ + MTL + PNG written and loaded back", "[assets]") {
 
 TEST_CASE("textured glTF 2.0 written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_gltf(a, scratch("gltf"), "asset");
+  const scratch dir("gltf");
+  const auto path = support::write_gltf(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -135,11 +142,11 @@ TEST_CASE("textured glTF 2.0 written and loaded back", "[assets]") {
 
 TEST_CASE("textured GLB (images embedded) written and loaded back", "[assets]") {
   const auto a = small_asset();
-  const auto dir = scratch("glb");
-  const auto path = support::write_glb(a, dir, "asset");
+  const scratch dir("glb");
+  const auto path = support::write_glb(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
-  for (unsigned k = 0; k < a.materials; ++k) fs::remove(dir / ("asset_" + std::to_string(k) + ".png"));  // only the embedded copies
+  for (unsigned k = 0; k < a.materials; ++k) fs::remove(dir.path / ("asset_" + std::to_string(k) + ".png"));  // only the embedded copies
   const auto parts = support::load_textured_mesh(*path);
   INFO(why(parts));
   REQUIRE(parts);
@@ -148,7 +155,8 @@ TEST_CASE("textured GLB (images embedded) written and loaded back", "[assets]") 
 
 TEST_CASE("textured PLY written and loaded back: texcoords and the TextureFile comment", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_ply(a, scratch("ply"), "asset");
+  const scratch dir("ply");
+  const auto path = support::write_ply(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   const auto parts = support::load_textured_mesh(*path);
@@ -185,7 +193,8 @@ TEST_CASE("the generated asset: over 50k triangles, six charts, three materials"
 
 TEST_CASE("demo scene with assets: one textured object per material; untextured meshes say what is skipped", "[assets]") {
   const auto a = small_asset();
-  const auto path = support::write_obj(a, scratch("scene"), "asset");
+  const scratch dir("scene");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path, support::cgal_mesh("fandisk")}});
@@ -208,6 +217,39 @@ TEST_CASE("demo scene with assets: one textured object per material; untextured 
   auto broken = support::make_demo_scene(device(), {.mesh_paths = {*path}});
   REQUIRE_FALSE(broken);
   CHECK_THAT(std::string(broken.error().message()), Catch::Contains("asset_1.png"));
+}
+
+TEST_CASE("shading an image texture takes the mip level of the pixel's footprint", "[assets][texture]") {
+  const auto a = small_asset();
+  const scratch dir("mips");
+  const auto path = support::write_obj(a, dir.path, "asset");
+  INFO(why(path));
+  REQUIRE(path);
+  auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path}});
+  INFO(why(scene));
+  REQUIRE(scene);
+  const std::uint32_t g = 4;  // material 0's object
+  const auto& mat = scene->objects[g].mat;
+  REQUIRE(mat.texture == support::texture_kind::image);
+  // An unshadowed, unoccluded record lit by the ambient term only: colour = albedo x ambient.
+  support::shading_inputs in;
+  in.geometry = g;
+  in.normal = {0.0f, 0.0f, 1.0f};
+  in.ao = 1.0f;
+  in.uv = {0.1234f, 0.4321f};
+  const float angle = support::pixel_angle(scene->view, 1025);
+  const support::reference_shader finest(*scene), mipped(*scene, {.pixel_angle = angle});
+  for (float distance : {0.5f, 8.0f, 200.0f}) {
+    in.position = scene->view.eye + glm::vec3(0.0f, 0.0f, distance);
+    const float lod = std::log2(distance * angle * mat.texels_per_unit);
+    const glm::vec3 want = support::albedo(mat, in.uv, lod) * scene->ambient;
+    CHECK(glm::distance(mipped.shade(in), want) < 1e-5f);
+    CHECK(glm::distance(finest.shade(in), mat.image->bilinear(in.uv, 0) * scene->ambient) < 1e-5f);
+  }
+  // Far away the footprint covers the whole 32² texture: its mean colour.
+  in.position = scene->view.eye + glm::vec3(0.0f, 0.0f, 1e6f);
+  const auto& top = mat.image->level(mat.image->level_count() - 1);
+  CHECK(glm::distance(mipped.shade(in), top.at(0, 0) * scene->ambient) < 1e-5f);
 }
 
 namespace {
@@ -265,7 +307,8 @@ std::pair<std::size_t, std::size_t> mixed_chart_pixels(const support::reference_
 
 TEST_CASE("UV seams: chart ids rendered through the upsampler never mix two charts", "[assets][seams]") {
   const auto a = support::make_textured_asset();
-  const auto path = support::write_obj(a, scratch("seams"), "asset");
+  const scratch dir("seams");
+  const auto path = support::write_obj(a, dir.path, "asset");
   INFO(why(path));
   REQUIRE(path);
   auto scene = support::make_demo_scene(device(), {.mesh_paths = {*path}, .mesh_size = 4.0f});
