@@ -51,9 +51,11 @@ struct lod_panel {
   support::image img;
 };
 
+// The mesh the LOD stage simplifies: the first object of the first --mesh file, or the built-in torus.
 inline const indexed_mesh& lod_source(const demo_context& ctx) {
   for (const auto& object : ctx.scene.objects)
-    if (!ctx.options.mesh_path.empty() ? object.name == ctx.options.mesh_path : object.name == "torus") return object.mesh;
+    if (ctx.options.mesh_paths.empty() ? object.name == "torus" : object.name.starts_with(ctx.options.mesh_paths.front()))
+      return object.mesh;
   return ctx.scene.objects.back().mesh;
 }
 
