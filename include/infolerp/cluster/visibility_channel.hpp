@@ -27,7 +27,7 @@
 // Options cut them: `coherent` and `cull_hull` exactly (the same counts), `adaptive_probes`
 // approximately (see visibility_channel). Option `images` measures OR the paper's way instead:
 // one image of primary rays per viewpoint (cluster/visibility_images.hpp).
-// OR is stored as visible-sample counts: T·N bytes. Deterministic: each count depends only on
+// OR is stored as visible-sample counts (round(255·OR) with images): T·N bytes. Deterministic: each count depends only on
 // its own rays.
 #include <algorithm>
 #include <bit>
@@ -584,8 +584,11 @@ struct visibility_channel {
   }
 
   // Traces the occlusion rays. Errors: viewpoints == 0, samples_per_side outside 1..15,
-  // radius_scale < 1 or NaN. Complexity O(T·N·n²) rays, allocation T·N bytes + one ray buffer
-  // per task. Thread-safety: the tracer is called concurrently from the executor's threads.
+  // radius_scale < 1 or NaN, and the image options (see images). Complexity O(T·N·n²) rays
+  // (images: N·R² primary rays + n² per fallback triangle and viewpoint), allocation T·N bytes +
+  // one ray buffer per task (+ T·N verdict bytes with adaptive_neighbours; + V points and
+  // T doubles and T bytes per task with images). Thread-safety: the tracer is called
+  // concurrently from the executor's threads.
   template <class M, class T, class E>
   result<prepared_visibility_channel> prepare(const M& m, const mesh_topology& topo, const T& tr, E& exec) const {
     static_assert(check_mesh<M>());
