@@ -104,7 +104,9 @@ inline bool stage_lod(demo_context& ctx) {
   const indexed_mesh m = support::weld_positions(detail::lod_source(ctx), remap);
   auto sal = compute_saliency(m);
   if (!sal) return report(sal.error()), false;
-  auto cl = salient_clustering(m, sal->saliency, {.clusters = 10});
+  // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
+  const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
+  auto cl = salient_clustering(m, sal->saliency, {.clusters = clusters});
   if (!cl) return report(cl.error()), false;
   auto w = weighting_map(m, sal->saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;

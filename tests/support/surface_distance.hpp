@@ -50,7 +50,14 @@ class surface_distance {
     lo_ = box.lo;
     const std::size_t nt = idx.size() / 3;
     const glm::dvec3 ext = box.hi - box.lo;
-    h_ = std::max(std::cbrt(ext.x * ext.y * ext.z / std::max<double>(1.0, static_cast<double>(nt))), 1e-9 * box.diagonal());
+    // About one triangle per cell: the cell side from the box's volume, or from its largest face
+    // or longest side where the mesh is flat or a line (a zero volume must not give tiny cells).
+    const double n = std::max<double>(1.0, static_cast<double>(nt));
+    glm::dvec3 e = ext;
+    if (e.x < e.y) std::swap(e.x, e.y);
+    if (e.y < e.z) std::swap(e.y, e.z);
+    if (e.x < e.y) std::swap(e.x, e.y);
+    h_ = std::max({std::cbrt(e.x * e.y * e.z / n), std::sqrt(e.x * e.y / n), e.x / n, 1e-9 * box.diagonal()});
     for (int a = 0; a < 3; ++a) n_[a] = std::max(1, static_cast<int>(std::ceil(ext[a] / h_)));
     cells_.resize(static_cast<std::size_t>(n_[0]) * static_cast<std::size_t>(n_[1]) * static_cast<std::size_t>(n_[2]));
     for (std::size_t t = 0; t < nt; ++t) {
