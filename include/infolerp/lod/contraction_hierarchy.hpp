@@ -441,14 +441,18 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   std::vector<std::pair<double, std::uint32_t>> ranked;
   std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
   auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.pos[v]); };
-  auto set_best = [&](std::uint32_t u) {
-    cm.ring(u, candidates);
+  // u's entry from its neighbours (ring(u)).
+  auto rank = [&](std::uint32_t u, const std::vector<std::uint32_t>& ring) {
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
-    for (std::uint32_t v : candidates)
+    for (std::uint32_t v : ring)
       if (const detail::collapse_entry e{cost(u, v), u, v}; e < best) best = e;
     fallback[u] = 0;
     if (best.v != invalid_id) heap.set(best);
     else heap.erase(u);
+  };
+  auto set_best = [&](std::uint32_t u) {
+    cm.ring(u, candidates);
+    rank(u, candidates);
   };
   auto fill = [&] {
     heap.reset(nv);
@@ -521,7 +525,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     --live;
     progress_since_fill = true;
     cm.ring(e.v, cm.ring_v);
-    set_best(e.v);
+    rank(e.v, cm.ring_v);
     // A neighbour x of v: x → u vanished and x → v may be new (its cost depends on Q_x and p_v
     // only); an entry not aiming at u stays exact unless x → v beats it. A vertex without an
     // entry or with a fallback one is ranked anew: its refused contractions may pass now.
