@@ -47,7 +47,8 @@
 // Preconditions: an edge-manifold mesh (checked), finite positions (checked).
 // Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
 // bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
-// cross-cluster dependency, 12 per triangle (the cluster-ordered index buffer), 4 per vertex.
+// cross-cluster dependency, 20 per triangle (the cluster-ordered index buffer and each
+// triangle's removing contraction and its cluster), 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -95,6 +96,9 @@ struct contraction_hierarchy {
   // The mesh's triangles grouped by cluster (index buffer order, original vertex ids) and the
   // triangle offsets of each cluster.
   std::vector<std::uint32_t> indices, triangle_offsets;
+  // Per triangle of that buffer: the contraction that removes it (invalid_id: none) and the
+  // cluster owning that contraction (0 when none).
+  std::vector<std::uint32_t> killer, killer_owner;
   std::uint32_t vertex_count = 0, cluster_count = 0;
   std::uint32_t local_contractions = 0;  // the first ones, that touch only their own cluster's vertices
 
@@ -109,7 +113,7 @@ struct contraction_hierarchy {
   [[nodiscard]] std::size_t memory_bytes() const {
     return 4 * (removed.size() + target.size() + parent.size() + owner.size() + error.size() + removal_order.size() +
                 cluster_offsets.size() + cluster_contractions.size() + cross_offsets.size() + 3 * cross.size() +
-                indices.size() + triangle_offsets.size()) +
+                indices.size() + triangle_offsets.size() + killer.size() + killer_owner.size()) +
            faces_removed.size();
   }
 };
@@ -215,7 +219,7 @@ class collapse_mesh {
   std::vector<glm::dvec3> pos;
   std::vector<glm::uvec3> tri;
   std::vector<char> tri_alive, alive, boundary;
-  std::vector<std::uint32_t> head, next, stamp, last_touch;
+  std::vector<std::uint32_t> head, next, stamp, last_touch, killed_by;
   std::vector<quadric> q;
   std::uint32_t stamp_now = 0;
   std::vector<std::uint32_t> ring_u, ring_v;
@@ -293,14 +297,15 @@ class collapse_mesh {
     });
     return ok;
   }
-  // Performs u → v; returns the triangles removed. ring_u must hold ring(u).
-  std::uint8_t collapse(std::uint32_t u, std::uint32_t v) {
+  // Performs u → v as contraction `order`; returns the triangles removed (killed_by names it).
+  std::uint8_t collapse(std::uint32_t u, std::uint32_t v, std::uint32_t order) {
     std::uint8_t removed = 0;
     std::uint32_t last = nil;
     for_each_triangle(u, [&](std::uint32_t t) {
       glm::uvec3& f = tri[t];
       if (f.x == v || f.y == v || f.z == v) {
         tri_alive[t] = 0;
+        killed_by[t] = order;
         ++removed;
         return;
       }
@@ -369,6 +374,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = glm::dvec3(mesh_position(m, v));
   cm.tri.resize(nt);
   cm.tri_alive.assign(nt, 1);
+  cm.killed_by.assign(nt, invalid_id);
   cm.alive.assign(nv, 0);
   cm.boundary.assign(nv, 0);
   cm.head.assign(nv, detail::collapse_mesh::nil);
@@ -441,14 +447,18 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   std::vector<std::pair<double, std::uint32_t>> ranked;
   std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
   auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.pos[v]); };
-  auto set_best = [&](std::uint32_t u) {
-    cm.ring(u, candidates);
+  // u's entry from its neighbours (ring(u)).
+  auto rank = [&](std::uint32_t u, const std::vector<std::uint32_t>& ring) {
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
-    for (std::uint32_t v : candidates)
+    for (std::uint32_t v : ring)
       if (const detail::collapse_entry e{cost(u, v), u, v}; e < best) best = e;
     fallback[u] = 0;
     if (best.v != invalid_id) heap.set(best);
     else heap.erase(u);
+  };
+  auto set_best = [&](std::uint32_t u) {
+    cm.ring(u, candidates);
+    rank(u, candidates);
   };
   auto fill = [&] {
     heap.reset(nv);
@@ -511,7 +521,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     for (std::size_t k = 0; k < dep_scratch.size(); ++k)  // the latest per cluster
       if (k + 1 == dep_scratch.size() || dep_scratch[k + 1].first != dep_scratch[k].first)
         crossing.push_back({owner[e.u], {order, dep_scratch[k].first, dep_scratch[k].second}});
-    const std::uint8_t gone = cm.collapse(e.u, e.v);
+    const std::uint8_t gone = cm.collapse(e.u, e.v, order);
     h.removed.push_back(e.u), h.target.push_back(e.v), h.parent.push_back(parent), h.owner.push_back(owner[e.u]);
     h.faces_removed.push_back(gone);
     h.error.push_back(static_cast<float>(e.cost));
@@ -521,7 +531,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     --live;
     progress_since_fill = true;
     cm.ring(e.v, cm.ring_v);
-    set_best(e.v);
+    rank(e.v, cm.ring_v);
     // A neighbour x of v: x → u vanished and x → v may be new (its cost depends on Q_x and p_v
     // only); an entry not aiming at u stays exact unless x → v beats it. A vertex without an
     // entry or with a fallback one is ranked anew: its refused contractions may pass now.
@@ -558,12 +568,15 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   for (std::size_t t = 0; t < nt; ++t) ++h.triangle_offsets[cluster[t] + 1];
   for (std::uint32_t c = 0; c < cluster_count; ++c) h.triangle_offsets[c + 1] += h.triangle_offsets[c];
   h.indices.resize(3 * nt);
+  h.killer.resize(nt), h.killer_owner.resize(nt);
   {
     std::vector<std::uint32_t> cursor(h.triangle_offsets.begin(), h.triangle_offsets.end() - 1);
     for (std::size_t t = 0; t < nt; ++t) {
       const glm::uvec3 f = mesh_triangle(m, t);
       const std::uint32_t k = cursor[cluster[t]]++;
       h.indices[3 * k] = f.x, h.indices[3 * k + 1] = f.y, h.indices[3 * k + 2] = f.z;
+      h.killer[k] = cm.killed_by[t];
+      h.killer_owner[k] = cm.killed_by[t] == invalid_id ? 0 : h.owner[cm.killed_by[t]];
     }
   }
   return h;

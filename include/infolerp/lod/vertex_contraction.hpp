@@ -11,6 +11,11 @@
 // the output in parallel; a serial pass moves the chunks together and records each cluster's
 // range (§IV.C binds one range per cluster). Chunk boundaries depend only on the hierarchy and
 // the grain, so the output has identical bits for any executor.
+// A triangle whose removing contraction (contraction_hierarchy::killer) is applied is skipped
+// without reading its indices: at dependency-closed stop points (neighbour matching's output,
+// or one global prefix) every earlier contraction that renamed its corners is a dependency of
+// that contraction and applied too, so the triangle is degenerate. This is a precondition:
+// stop points that are not dependency-closed may lose triangles that would not be degenerate.
 // One vertex map serves every cluster, so a vertex on a cluster border contracts the same way
 // in all of them (the paper ensures this with the shared-cluster texture).
 #include <algorithm>
@@ -75,7 +80,7 @@ inline void resolve_vertex_map(const contraction_hierarchy& h, std::span<const s
 // Algorithm 1: the frame's index buffer into out (at least contracted_index_bound(h) entries)
 // and one range per cluster. Returns the indices written. Errors: out too small or ranges not
 // one per cluster (bad_size), stop not one per cluster (bad_size). Preconditions: w from this
-// hierarchy. O(T / threads + chunks), no allocation unless an error is returned; identical bits
+// hierarchy; stop dependency-closed (see the top of the file). O(T / threads + chunks), no allocation unless an error is returned; identical bits
 // for any executor.
 template <class E = serial_executor>
 result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
@@ -91,12 +96,16 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
   resolve_vertex_map(h, stop, w);
   const std::uint32_t* remap = w.remap.data();
   const std::uint32_t* src = h.indices.data();
+  const std::uint32_t* killer = h.killer.data();
+  const std::uint32_t* killer_owner = h.killer_owner.data();
+  const std::uint32_t* stops = stop.data();
   std::uint32_t* dst = out.data();
   exec.parallel_for(w.chunk_cluster.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       std::uint32_t* o = dst + 3 * std::size_t{w.chunk_begin[k]};
       std::uint32_t* const o0 = o;
       for (std::size_t t = w.chunk_begin[k]; t < w.chunk_begin[k + 1]; ++t) {
+        if (killer[t] < stops[killer_owner[t]]) continue;  // removed (see the top of the file)
         const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
         o[0] = a, o[1] = bb, o[2] = c;
         o += (a != bb && bb != c && a != c) ? 3 : 0;
