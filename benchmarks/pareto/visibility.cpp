@@ -121,8 +121,10 @@ std::vector<config> configs() {
       out.back().stream = true;
     }
   // The paper's measurement: one image per viewpoint (resolution R, fallback under M pixels).
-  for (const auto& [res, min_pixels] : std::vector<std::pair<std::uint32_t, double>>{
+  for (const auto& [r, m] : std::vector<std::pair<std::uint32_t, double>>{
            {256, 4.0}, {512, 1.0}, {512, 4.0}, {512, 16.0}, {1024, 4.0}}) {
+    const std::uint32_t res = r;  // copies: clang 14 cannot capture structured bindings
+    const double min_pixels = m;
     char setting[32];
     std::snprintf(setting, sizeof setting, "r%u_m%g_stream", res, min_pixels);
     with("images", setting, [=](visibility_channel& c) {
