@@ -2,53 +2,27 @@
 // Saliency-weighted quadric simplification into a contraction hierarchy (salient-clustering
 // paper §III.C, with the bookkeeping §IV.A's neighbour matching needs).
 //
-// Garland–Heckbert quadrics: each triangle's plane quadric, scaled by its area and by the
-// weighting map's value at each corner (weighting_map.hpp), is added to that corner's vertex;
-// mesh-boundary edges add a perpendicular plane (boundary_weight × squared edge length) to
-// both ends. Contractions are half-edge collapses u → v (u is removed, v keeps its position),
-// so every level of detail indexes the original vertices and the per-view pass only remaps
-// indices; a contraction adds Q_u to Q_v. Cost of u → v: Q_u(p_v) / A_u, A_u the triangle area
-// Q_u has gathered (without the saliency weights): the area-weighted mean of the weighted
-// squared distances from p_v to the planes u stands for, so that the saliency weight, not the
-// area already gathered, decides what goes first (Q_v(p_v) is v's own error so far, the same
-// for every contraction into v, and is left out; meshoptimizer ranks its collapses the same
-// way, and measured on bunny00, armadillo and refined_elephant the unnormalised sum
-// (Q_u + Q_v)(p_v) left larger distances at every triangle count). Pairs are ordered globally over the whole mesh
-// (connectivity across cluster borders is kept) by (cost, u, v): a binary heap holds each
-// vertex's cheapest contraction, updated in place when a contraction changes the vertex's
-// quadric or neighbours; a vertex whose cheapest contraction is refused is queued with its
-// cheapest allowed one, or left out until its neighbourhood changes. When the heap runs dry
-// every vertex is queued once more, until a round performs no contraction.
-// A contraction is refused when it would: create a non-manifold edge or a duplicate triangle
-// (link condition: the common neighbours of u and v are exactly the vertices opposite edge uv),
-// flip or flatten a triangle (the angle between old and new normal must stay below
-// acos(min_normal_cos), so the dot product stays positive), or move a
-// mesh-boundary vertex off its boundary (a boundary u may only move along a boundary edge).
-// Cluster-local phase (cluster_local_first): with one global order, a cluster performs a prefix
-// of it, so depending on one late contraction of a neighbour means performing all of that
-// neighbour's earlier ones; near the coarse end every contraction depends on late neighbours,
-// and neighbour matching would drag every cluster to the coarsest one. So the build first
-// performs only contractions whose removed vertex, target and both 1-rings are all owned by one
-// cluster: these depend on nothing outside it, and clusters simplify independently until only
-// bands along their borders are left; then contractions run over the whole mesh as above.
-// Simplification stops at the backstop: backstop × V vertices left (the paper stops at 1%).
+// Quadrics (Garland–Heckbert): each triangle's plane quadric, scaled by its area and the
+// weighting map (weighting_map.hpp) at each corner, goes to that corner; mesh-boundary edges add
+// a perpendicular plane (boundary_weight × squared length). Contractions are half-edge collapses
+// u → v (v keeps its position, so every level indexes the original vertices) costing
+// Q_u(p_v) / A_u, A_u the unweighted area Q_u gathered, so that saliency, not gathered area,
+// decides the order. Order: global by (cost, u, v), one heap entry per vertex (its cheapest
+// allowed contraction, updated in place); refused: non-manifold or duplicate results (link
+// condition), a normal turning past acos(min_normal_cos), a boundary vertex leaving its boundary.
+// Cluster-local phase (cluster_local_first): contractions whose vertices and 1-rings lie in one
+// cluster run first, so clusters simplify independently and neighbour matching does not drag
+// every cluster to the coarsest; then the whole mesh, down to backstop × V vertices (paper: 1%).
 //
-// Hierarchy: for contraction i (its global order): removed[i], target[i], and parent[i], the
-// order of the last contraction it depends on: the latest contraction that changed the
-// triangle fan of u, v or any neighbour of u or v (none: no_parent). Each contraction belongs
-// to the cluster owning its removed vertex (the cluster of the vertex's lowest-index triangle);
-// a cluster's capacity is the number of contractions it owns, its local capacity those of the
-// cluster-local phase (what view_dependent_lod hands distribute_contractions). For neighbour
-// matching, each contraction whose dependencies include contractions owned by other clusters
-// records, per such cluster, the latest of them (cross_dependency):
-// dependencies inside the own cluster are met by construction (a cluster always performs a
-// prefix of its contractions in global order).
+// Hierarchy, per contraction i: removed[i], target[i], parent[i] (the last contraction that
+// changed the fan of u, v or a neighbour; no_parent if none), its owning cluster (that of the
+// removed vertex's lowest-index triangle) and, per other cluster it depends on, the latest such
+// contraction (cross_dependency). A cluster's capacity is the contractions it owns.
 //
-// Preconditions: an edge-manifold mesh (checked), finite positions (checked).
+// Preconditions: an edge-manifold mesh, finite positions (both checked).
 // Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
 // bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
-// cross-cluster dependency, 20 per triangle (the cluster-ordered index buffer and each
-// triangle's removing contraction and its cluster), 4 per vertex.
+// cross-cluster dependency, 20 per triangle, 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

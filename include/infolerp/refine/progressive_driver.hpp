@@ -1,60 +1,34 @@
 #pragma once
 // Progressive refinement along a walkthrough: Oliveira, Santos, Proença, "Refinement Criteria
 // for High Fidelity Interactive Walkthroughs", §2 (the Shading Management Agent: visibility, an
-// object-space shading cache, asynchronous shading requests, the incremental add/delete
-// protocol), §4.1 (refinement interrupted after every R selections) and §5 (the Table 1
-// figures: Δ, Δ_total, shading samples and time at stage 1 and stage 2).
+// object-space shading cache, asynchronous shading, the incremental add/delete protocol), §4.1
+// (refinement interrupted after every R selections) and §5 (Table 1: Δ, Δ_total, samples, time).
 //
-// Views. set_view() traces one primary ray per pixel through the user's tracer
-// (core/tracer.hpp): the hit's triangle and barycentrics locate the pixel in the subdivision
-// hierarchy, so later splits re-locate pixels without tracing again (subdivision is planar).
-// A leaf's projected area is the number of pixels it shows. The hierarchy and every shaded
-// value survive a view change; only leaves shown in the current view are refined, requested or
-// displayed. start() is a full restart: the hierarchy returns to the mesh given to create(),
-// the cache is emptied and every figure restarts.
+// Views: set_view() traces one primary ray per pixel (core/tracer.hpp); the hit's barycentrics
+// locate the pixel in the subdivision hierarchy, so later (planar) splits re-locate pixels
+// without tracing. Hierarchy and cache survive view changes; only leaves shown now are refined,
+// requested or displayed. start() is a full restart.
+// Cache: one colour per hierarchy vertex (object space, the paper's Lambertian restriction),
+// 20 bytes per vertex plus 32 per hierarchy triangle. With max_cached_samples, vertices outside
+// the view are evicted least recently visible first; the current view's are never evicted, and
+// refinement stops (cache_full) once they alone reach the bound.
+// Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
+// hands out shading_points, deliver() takes colours for any subset in any order, from any thread
+// or machine (calls on one refiner must not overlap). shade_requests() is the synchronous adaptor.
+// A batch runs only when nothing is outstanding, so results are bit-identical for any executor
+// and delivery order.
+// L_max (§4): the largest luminance of the current image, recomputed before every selection;
+// Rec. 709 luminance of the linear colour stands in for Drago et al.'s tone mapper (S is
+// scale-free under it).
+// Display: a triangle is shown once its corners are shaded; a split one stays shown until its
+// children are ready, so the shown set is always a non-overlapping cut of the hierarchy.
+// take_delta() gives the changes in the paper's order: added from the cache, deleted, newly shaded.
+// Figures: stage 1 shades every visible leaf's vertices; stage 2 runs batches (criteria.hpp)
+// until the criterion selects nothing, the budget is reached (checked per batch) or max_batches
+// ran. Δ: leaves shown now; Δ_total: triangles ever shown since start().
 //
-// Cache. One colour per hierarchy vertex (object space; the paper's Lambertian restriction):
-// 16 bytes + 4 bytes of visibility stamp per vertex plus the hierarchy itself (32 bytes per
-// triangle, ~3 triangles per vertex). With driver_options.max_cached_samples set, shaded
-// vertices outside the current view are evicted least recently visible first (ties by id)
-// whenever more are held; vertices of the current view are never evicted, so one view that
-// alone needs more than the bound exceeds it, and refinement stops (cache_full) once the
-// current view's vertices alone reach the bound.
-//
-// Shading. Every vertex of a shown leaf, and every corner of its ancestors (the display falls
-// back to them, see below), is requested once: take_requests() hands out shading_points
-// (vertex id, position, normal, original triangle), deliver() accepts colours for any subset
-// of outstanding requests in any order. The library never calls a renderer in this mode, so
-// requests may be shaded on other threads or machines; calls on one refiner must not overlap
-// (serialise deliveries from worker threads, e.g. with a mutex). shade_requests() is the
-// synchronous adaptor (shade on the executor, deliver at once). A refinement batch only runs
-// when no request is outstanding, so images and figures are bit-identical for any executor and
-// any delivery order.
-//
-// L_max (§4): the largest interpolated luminance of the current image, recomputed before every
-// selection. The paper takes luminance from Drago et al.'s tone mapper; we use the Rec. 709
-// luminance of the linear colour (nld.hpp), a linear map, under which S is scale-free.
-//
-// Display. A triangle is shown once its three corners are shaded; a split triangle stays shown
-// until every child leading to a shown leaf is ready (the paper: "whenever a triangle's
-// children are shaded ... display the new triangles and delete the original one"). The shown
-// set is thus always a cut of the hierarchy over the view, never overlapping. take_delta()
-// reports how it changed since the last call, in the paper's order: triangles added from the
-// cache, triangles deleted, triangles added with newly shaded corners.
-//
-//  stage 1: every vertex of every visible leaf shaded once (recorded at the first refine call);
-//  stage 2: batches of R selections (criteria.hpp), each followed by re-location and requests
-//           for the new visible vertices, until the criterion selects nothing, the shading
-//           budget is reached (checked after each batch, so one batch may overshoot it) or
-//           max_batches ran.
-//  Δ        leaves shown (visible) now;
-//  Δ_total  triangles ever shown since start() (the paper: "sent to the visualizer", which
-//           counts split ones); triangles_produced additionally counts children never shown.
-//
-// The tracer must model infolerp::tracer; the scene's triangle ids must be the mesh's (the
-// hit's geometry id is ignored). The synchronous shading callback,
-// glm::vec3 shade(const shading_point&), is called once per request, concurrently from the
-// executor's threads.
+// The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
+// glm::vec3 shade(const shading_point&) is called once per request, concurrently.
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -8,8 +8,7 @@
 // textured colours (§5, Fig. 12), so a sample becomes a colour only after interpolation.
 // Beyond the paper: the default record's interpolation is perspective-correct when the engine
 // fills inv_depth (1 / view depth): the paper's screen-linear weights misplace texcoords on
-// surfaces seen at an angle, which was the largest error on the demo scene (benchmarks/NOTES.md,
-// infolerp_pareto upsample).
+// surfaces seen at an angle.
 //
 // A sample source S models:
 //   typename S::sample_type                               the I-Buffer record (copyable)
@@ -29,37 +28,25 @@
 // Pixel coordinates may lie outside the image, up to 2^(passes-1) - 1 beyond its right and
 // bottom edge (the cropped border of §4); a pinhole camera extrapolates naturally.
 //
-// Optionally, a probe: the cheap, sharp part of a sample evaluated at every pixel, the
-// expensive, smooth part interpolated (the CPU counterpart of the per-pixel cluster-ID buffer a
-// rasteriser gives for free). A source with probes also models:
-//   sample_type probe(uint32_t x, uint32_t y) const     the primary hit at (x, y): cluster id
-//        and whatever comes with it cheaply (position, normal, texcoords, hard-shadow bits);
-//        the expensive terms (occlusion) left unset
-//   sample_type interpolate(const sample_type& probe, a, b)        the probe with the expensive
-//   sample_type interpolate(const sample_type& probe, a, b, c, d)  terms of a, b or a..d
-// (members, or free functions found by ADL; the default record has them), and optionally
-//   bool probe_compatible(const sample_type& probe, const sample_type& s)   may s complete probe?
-// (member or ADL; default compatible(probe, s)), for probes that leave out part of what
-// compatible() compares, e.g. hard-shadow bits that stay interpolated. The upsampler then tests
-// each new sample's own probe against its sources, and the chosen sources against each other
-// with compatible() (upsampler.hpp). Such a source may also offer
-//   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const
-//        the probe with what it left out added (e.g. the hard-shadow rays), so that compatible()
-//        holds between it and a source exactly when it would for the full evaluation
-// and then probes stay cheap: the upsampler refines a probe only where sources that agree
-// with each other and bracket the new sample do not suffice (upsampler.hpp). On the demo
-// scene (1025², 4 passes) 2.8% of the probes are refined with 518 ids, 2.0% with 159, so about
-// 97% of the probes trace no sun ray.
+// Optionally, a probe (the CPU counterpart of a rasteriser's per-pixel cluster-ID buffer): the
+// cheap, sharp part of a sample at every pixel, the expensive, smooth part interpolated:
+//   sample_type probe(uint32_t x, uint32_t y) const      primary hit: cluster id and what comes
+//        cheaply with it (position, normal, texcoords, hard-shadow bits); occlusion left unset
+//   sample_type interpolate(const sample_type& probe, a, b)  /  (probe, a, b, c, d)
+//        the probe completed with the expensive terms of its sources (member or ADL)
+//   bool probe_compatible(const sample_type& probe, const sample_type& s)   optional (member or
+//        ADL; default compatible): for probes that leave out part of what compatible() compares
+//   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const   optional:
+//        adds what the probe left out (e.g. hard-shadow rays) so that compatible() then holds
+//        exactly as for the full evaluation; the upsampler calls it only where the agreeing,
+//        bracketing sources do not suffice (upsampler.hpp)
 //
-// Optionally, beyond the paper (adaptive refinement on top of the §4 test, any source):
-//   bool agree(const sample_type& a, const sample_type& b) const     may a and b be sources of
-//        one interpolation? e.g. their expensive terms differ by at most a tolerance
-//        (occlusion_within below for the default record)
-// (member only: a tolerance is the source's state). A new sample whose sources passed the §4
-// test is still evaluated unless every pair of its chosen sources agrees. agree() need not be
-// transitive: the upsampler tests all pairs (1 for an edge or a diagonal, 6 for four corners),
-// never only against a first source. It must be symmetric, thread-safe and deterministic like
-// compatible(); a source that always agrees gives exactly the frame of one without agree().
+// Optionally, beyond the paper (adaptive refinement on top of the §4 test):
+//   bool agree(const sample_type& a, const sample_type& b) const   (member: a tolerance is the
+//        source's state) e.g. expensive terms within a tolerance (occlusion_within below); a new
+//        sample is evaluated unless every pair of its sources agrees. Need not be transitive
+//        (all pairs are tested); symmetric, thread-safe and deterministic like compatible(). A
+//        source that always agrees gives exactly the frame of one without agree().
 #include <array>
 #include <concepts>
 #include <cstddef>

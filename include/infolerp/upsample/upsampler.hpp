@@ -1,48 +1,27 @@
 #pragma once
 // The I-Buffer upsampler: multi-pass rendering that evaluates samples only where the picture
-// changes and interpolates everywhere else.
+// changes and interpolates everywhere else ("Feature-based clustered geometry for interpolated
+// Ray-casting", §4, Fig. 7). The first pass evaluates a coarse grid; each pass goes to
+// (2N−1)×(2M−1): samples that coincide with the previous pass are re-used (R), a new sample
+// between 2 (edge) or 4 (centre) previous ones is interpolated (I) when they are compatible
+// (same cluster id and hard-shadow light bits, §4.1), otherwise evaluated (E). One buffer per pass.
 //
-// Paper: "Feature-based clustered geometry for interpolated Ray-casting", §4 (Fig. 7). The
-// first pass evaluates a coarse N×M grid; each pass goes to (2N−1)×(2M−1): samples that
-// coincide with the previous pass are re-used (R), a new sample between 2 (edge) or 4 (centre)
-// previous samples is interpolated (I) when those samples are compatible (same cluster id, same
-// hard-shadow light bits, §4.1), otherwise evaluated (E). One buffer per pass (the I-Buffer
-// pyramid, "about one-third of the final image size" on top of the final buffer).
+// Any output size: the last pass has the image size W×H, and a pass of width w needs
+// floor(w/2) + 1 samples of the one before; every kept sample sits where the paper's uncropped
+// pyramid puts it, so the result is the crop of the paper's, with at most 2^(passes−1) − 1
+// pixels evaluated beyond the right and bottom edges.
 //
-// Any output size: the paper starts from an N×M grid whose last pass covers the image and crops
-// the border. We compute exactly the same samples but skip the cropped ones: the last pass has
-// the image size W×H and a pass of size w needs w' = floor(w/2) + 1 samples of the pass before
-// it. Every kept sample sits where the paper's uncropped pyramid puts it (pixel (i·2^d, j·2^d)
-// for a sample (i, j) d passes before the last), so the result is the crop of the paper's.
-// At most 2^(passes−1) − 1 pixels beyond the right and bottom edge are evaluated.
+// Probes (optional, sample_source.hpp): a source that can evaluate a sample's cheap primary hit
+// at every pixel gets the §4 test with the new sample's own cluster id; matching sources give
+// only the expensive terms (AO, soft shadows), otherwise the sample is evaluated. refine_probe
+// adds the hard-shadow rays only where the agreeing, bracketing sources do not suffice.
+// Agreeing sources (optional, beyond the paper): with agree(a, b), a new sample is evaluated
+// unless every pair of its chosen sources agrees (all pairs: agreement is not transitive).
 //
-// Probes (optional, sample_source.hpp): a source that can evaluate the cheap part of a sample
-// (its primary hit: cluster id, position, normal, texcoords, optionally hard-shadow bits) at
-// every pixel gets the §4 test with the new sample's OWN cluster id, as a per-pixel ID buffer
-// would give it: a new sample probes its pixel and takes only the expensive terms (AO, soft
-// shadows) from the previous-pass sources that match its probe (see probe_row for which);
-// with no match it is evaluated. Cost: one probe per new sample (each pixel is probed once:
-// R samples keep their probe), so a probe must be much cheaper than an evaluation to pay off.
-// Cheaper still, a source may probe only the primary ray and refine a probe with the
-// hard-shadow rays where the sources that agree with each other and bracket the new sample do
-// not suffice (refine_probe, sample_source.hpp): ~2-3% of the probes on the demo scene.
-//
-// Agreeing sources (optional, beyond the paper): a source with agree(a, b) has a new sample
-// evaluated, not interpolated, unless every pair of the sources chosen for it agrees (e.g. AO
-// and soft shadows within a tolerance, occlusion_within), in both the plain and the probe
-// path. This is adaptive refinement on top of the §4 test: a tolerance gives evaluated
-// fractions between those of two pass counts. It is not transitive, so all pairs are tested
-// (one for an edge or a diagonal, six for four corners). Cost: those agree() calls per new
-// sample plus the extra evaluations; sources without agree() compile it out.
-//
-// Measured (benchmarks/results/upsample_1025.csv: demo scene 1025², AO 64 + soft 16 rays, hard
-// Time against error on the demo scene, beside joint-bilateral upsampling in the same run:
-// benchmarks/NOTES.md (infolerp_pareto upsample).
-// Determinism: each output row of a pass depends only on the previous pass, so rows run in
-// parallel through the user's executor and the output is identical for any executor and thread
-// count. Time is measured with `Clock` (std::chrono::steady_clock by default, or the user's) for
-// the statistics only; it never changes a pixel. Only a pass controller that the user feeds
-// with these times (pass_controller.hpp) can change the output, through the pass count.
+// Determinism: each row of a pass depends only on the previous pass, so rows run in parallel
+// through the user's executor with identical output for any executor. `Clock` times feed the
+// statistics only; only a pass controller fed with them (pass_controller.hpp) changes the
+// output, through the pass count. Time against error: benchmarks/NOTES.md.
 #include <algorithm>
 #include <array>
 #include <chrono>
