@@ -610,10 +610,11 @@ class progressive_refiner {
     luminance_.resize(nv, 0.0f);
     last_seen_.resize(nv, 0);
     delivered_epoch_.resize(nv, 0);
-    visible_.clear();
     for (std::uint32_t leaf : pixel_leaf_)
-      if (leaf != invalid_id && leaf_pixels_[leaf]++ == 0) visible_.push_back(leaf);
-    std::sort(visible_.begin(), visible_.end());
+      if (leaf != invalid_id) ++leaf_pixels_[leaf];
+    visible_.clear();  // ascending by a scan: cheaper than sorting the leaves as found
+    for (std::uint32_t t = 0; t < nt; ++t)
+      if (leaf_pixels_[t] != 0) visible_.push_back(t);
     for (std::uint32_t t : visible_)
       if (!ever_shown_[t]) ever_shown_[t] = 1, ++ever_shown_count_;
     // In view: the visible leaves and their ancestors; their corners are stamped and requested.
@@ -654,23 +655,34 @@ class progressive_refiner {
   }
 
   // The shown set: for each visible leaf, walk down from its root while triangles are ready and
-  // expand (the cut described in the prologue).
+  // expand (the cut described in the prologue). A triangle's outcome depends on its ancestors
+  // alone, so each in-view triangle is decided once per call: O(in-view triangles), not
+  // O(visible · level).
   void update_display() {
+    const std::size_t nt = mesh_.triangle_count();
+    if (++display_clock_ == 0) decided_.assign(nt, 0), shown_mark_.assign(nt, 0), display_clock_ = 1;
+    decided_.resize(nt, 0);
+    shown_mark_.resize(nt, 0);
+    decision_.resize(nt);
     shown_.clear();
     for (std::uint32_t leaf : visible_) {
       path_.clear();
-      for (std::uint32_t t = leaf; t != invalid_id; t = mesh_.triangle(t).parent) path_.push_back(t);
-      std::uint32_t d = invalid_id;
+      std::uint32_t t = leaf;
+      for (; t != invalid_id && decided_[t] != display_clock_; t = mesh_.triangle(t).parent) path_.push_back(t);
+      display_step above = t == invalid_id ? display_step{invalid_id, true} : decision_[t];
       for (auto it = path_.rbegin(); it != path_.rend(); ++it) {
-        if (!ready(*it)) break;
-        d = *it;
-        if (*it == leaf || !expands(*it)) break;
+        if (above.open) {
+          if (!ready(*it)) above.open = false;
+          else above = {*it, *it != leaf && expands(*it)};
+        }
+        decided_[*it] = display_clock_;
+        decision_[*it] = above;
       }
-      display_of_[leaf] = d;
-      if (d != invalid_id) shown_.push_back(d);
+      display_of_[leaf] = above.shown;
+      if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
+        shown_mark_[above.shown] = display_clock_, shown_.push_back(above.shown);
     }
     std::sort(shown_.begin(), shown_.end());
-    shown_.erase(std::unique(shown_.begin(), shown_.end()), shown_.end());
   }
 
   // Least recently visible first (ties by id), never a vertex of the current view.
@@ -726,6 +738,15 @@ class progressive_refiner {
   std::vector<std::uint32_t> visible_;
   std::vector<std::uint32_t> in_view_;     // per triangle: clock_ when it or a descendant is visible
   std::vector<std::uint32_t> display_of_;  // per visible leaf: the shown triangle over it
+  // update_display()'s per-triangle outcome (shown so far, walk goes on) stamped with
+  // display_clock_, and its mark of triangles already in shown_.
+  struct display_step {
+    std::uint32_t shown = invalid_id;
+    bool open = true;
+  };
+  std::vector<display_step> decision_;
+  std::vector<std::uint32_t> decided_, shown_mark_;
+  std::uint32_t display_clock_ = 0;
   std::vector<std::uint8_t> ever_shown_;
   std::size_t ever_shown_count_ = 0;
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
