@@ -1,6 +1,7 @@
 // Weighting map, contraction hierarchy, per-view selection and vertex contraction
 // (salient-clustering paper §III.C, §IV).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -238,14 +239,17 @@ TEST_CASE("vertex contraction: the triangles a cluster keeps are prefixes of run
     for (auto& s : stop) s = static_cast<std::uint32_t>(rng() % (h->contraction_count() + 1));
     auto n = contract_indices(*h, stop, w, out, ranges);
     REQUIRE(n.ok());
-    const auto ref = reference_indices(*h, stop);
-    std::size_t at = 0;
-    for (std::size_t k = 0; k < *n; k += 3) {
-      while (at < ref.size() && !std::equal(ref.begin() + static_cast<long>(at), ref.begin() + static_cast<long>(at + 3),
-                                            out.begin() + static_cast<long>(k)))
-        at += 3;
-      REQUIRE(at < ref.size());
-      at += 3;
+    const auto as_triangles = [](std::span<const std::uint32_t> idx) {
+      std::vector<std::array<std::uint32_t, 3>> t(idx.size() / 3);
+      for (std::size_t k = 0; k < t.size(); ++k) t[k] = {idx[3 * k], idx[3 * k + 1], idx[3 * k + 2]};
+      return t;
+    };
+    const auto ref = as_triangles(reference_indices(*h, stop));
+    auto next = ref.begin();  // each output triangle appears in the reference after the previous one
+    for (const auto& tri : as_triangles(std::span<const std::uint32_t>(out.data(), *n))) {
+      next = std::find(next, ref.end(), tri);
+      REQUIRE(next != ref.end());
+      ++next;
     }
     std::size_t kept = 0;
     for (std::size_t t = 0; t < h->triangle_count(); ++t) kept += h->killer[t] >= stop[run_of(t)] ? 1 : 0;
