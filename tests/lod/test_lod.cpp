@@ -1,6 +1,7 @@
 // Weighting map, contraction hierarchy, per-view selection and vertex contraction
 // (salient-clustering paper §III.C, §IV).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -203,6 +204,64 @@ TEST_CASE("a closed mesh stays closed at every budget; dependencies and budgets 
       CHECK(at == *n);
     }
   }
+}
+
+TEST_CASE("vertex contraction: the triangles a cluster keeps are prefixes of runs", "[lod]") {
+  const indexed_mesh m = support::make_torus(24, 12, 1.0f, 0.35f);
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  auto h = uniform_hierarchy(m, cl, 8, 0.01);
+  REQUIRE(h.ok());
+  // Inside a cluster: runs by the owner of the removing contraction (never removed: owner 0),
+  // latest removal first, so that a stop point keeps a prefix of each run.
+  auto run_of = [&](std::size_t t) { return h->killer[t] == invalid_id ? 0u : h->owner[h->killer[t]]; };
+  std::size_t runs = 0;
+  for (std::uint32_t c = 0; c < 8; ++c)
+    for (std::size_t t = h->triangle_offsets[c]; t < h->triangle_offsets[c + 1]; ++t) {
+      INFO("triangle " << t);
+      if (t == h->triangle_offsets[c]) {
+        ++runs;
+      } else if (run_of(t) != run_of(t - 1)) {
+        REQUIRE(run_of(t - 1) < run_of(t));
+        ++runs;
+      } else {
+        REQUIRE(h->killer[t - 1] >= h->killer[t]);
+      }
+    }
+  CHECK(runs > 8);  // triangles on cluster borders are removed by other clusters' contractions
+  // Stop points that are not dependency-closed: triangles may be lost (their gaps closed), never
+  // invented, reordered or degenerate.
+  contraction_workspace w = make_contraction_workspace(*h, 5);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), stop(8);
+  std::vector<index_range> ranges(8);
+  std::mt19937 rng(11);
+  std::size_t dropped = 0;  // kept by their runs, dropped as degenerate: gaps the pass closes
+  for (int trial = 0; trial < 40; ++trial) {
+    for (auto& s : stop) s = static_cast<std::uint32_t>(rng() % (h->contraction_count() + 1));
+    auto n = contract_indices(*h, stop, w, out, ranges);
+    REQUIRE(n.ok());
+    const auto as_triangles = [](std::span<const std::uint32_t> idx) {
+      std::vector<std::array<std::uint32_t, 3>> t(idx.size() / 3);
+      for (std::size_t k = 0; k < t.size(); ++k) t[k] = {idx[3 * k], idx[3 * k + 1], idx[3 * k + 2]};
+      return t;
+    };
+    const auto ref = as_triangles(reference_indices(*h, stop));
+    auto next = ref.begin();  // each output triangle appears in the reference after the previous one
+    for (const auto& tri : as_triangles(std::span<const std::uint32_t>(out.data(), *n))) {
+      next = std::find(next, ref.end(), tri);
+      REQUIRE(next != ref.end());
+      ++next;
+    }
+    std::size_t kept = 0;
+    for (std::size_t t = 0; t < h->triangle_count(); ++t) kept += h->killer[t] >= stop[run_of(t)] ? 1 : 0;
+    dropped += kept - *n / 3;
+    std::size_t at_range = 0;  // ranges tile the output in cluster order
+    for (std::uint32_t c = 0; c < 8; ++c) {
+      if (ranges[c].count) CHECK(ranges[c].first == at_range);
+      at_range += ranges[c].count;
+    }
+    CHECK(at_range == *n);
+  }
+  CHECK(dropped > 0);
 }
 
 TEST_CASE("vertex contraction: identical bits for any executor", "[lod]") {

@@ -22,7 +22,7 @@
 // Preconditions: an edge-manifold mesh, finite positions (both checked).
 // Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
 // bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
-// cross-cluster dependency, 20 per triangle, 4 per vertex.
+// cross-cluster dependency, 16 per triangle, 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -68,11 +68,12 @@ struct contraction_hierarchy {
   std::vector<std::uint32_t> cross_offsets;
   std::vector<cross_dependency> cross;
   // The mesh's triangles grouped by cluster (index buffer order, original vertex ids) and the
-  // triangle offsets of each cluster.
+  // triangle offsets of each cluster. Inside a cluster: by the owner of the contraction that
+  // removes the triangle, then latest removal first (never removed: first, with owner 0), so
+  // that at any stop point a cluster keeps a prefix of each owner's run (vertex_contraction.hpp).
   std::vector<std::uint32_t> indices, triangle_offsets;
-  // Per triangle of that buffer: the contraction that removes it (invalid_id: none) and the
-  // cluster owning that contraction (0 when none).
-  std::vector<std::uint32_t> killer, killer_owner;
+  // Per triangle of that buffer: the contraction that removes it (invalid_id: none).
+  std::vector<std::uint32_t> killer;
   std::uint32_t vertex_count = 0, cluster_count = 0;
   std::uint32_t local_contractions = 0;  // the first ones, that touch only their own cluster's vertices
 
@@ -87,7 +88,7 @@ struct contraction_hierarchy {
   [[nodiscard]] std::size_t memory_bytes() const {
     return 4 * (removed.size() + target.size() + parent.size() + owner.size() + error.size() + removal_order.size() +
                 cluster_offsets.size() + cluster_contractions.size() + cross_offsets.size() + 3 * cross.size() +
-                indices.size() + triangle_offsets.size() + killer.size() + killer_owner.size()) +
+                indices.size() + triangle_offsets.size() + killer.size()) +
            faces_removed.size();
   }
 };
@@ -537,20 +538,27 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     std::vector<std::uint32_t> cursor(h.cross_offsets.begin(), h.cross_offsets.end() - 1);
     for (const auto& x : crossing) h.cross[cursor[x.first]++] = x.second;
   }
-  // Index buffer grouped by cluster (stable: triangle order inside a cluster is kept).
+  // Index buffer grouped by cluster, then by the removing contraction's owner, latest removal
+  // first (see the struct); ties keep the input order.
   h.triangle_offsets.assign(cluster_count + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) ++h.triangle_offsets[cluster[t] + 1];
   for (std::uint32_t c = 0; c < cluster_count; ++c) h.triangle_offsets[c + 1] += h.triangle_offsets[c];
-  h.indices.resize(3 * nt);
-  h.killer.resize(nt), h.killer_owner.resize(nt);
   {
-    std::vector<std::uint32_t> cursor(h.triangle_offsets.begin(), h.triangle_offsets.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t) {
-      const glm::uvec3 f = mesh_triangle(m, t);
-      const std::uint32_t k = cursor[cluster[t]]++;
+    std::vector<std::uint32_t> perm(nt);
+    for (std::uint32_t t = 0; t < nt; ++t) perm[t] = t;
+    const auto kill_owner = [&](std::uint32_t t) { return cm.killed_by[t] == invalid_id ? 0 : h.owner[cm.killed_by[t]]; };
+    std::sort(perm.begin(), perm.end(), [&](std::uint32_t a, std::uint32_t b) {
+      if (cluster[a] != cluster[b]) return cluster[a] < cluster[b];
+      if (kill_owner(a) != kill_owner(b)) return kill_owner(a) < kill_owner(b);
+      if (cm.killed_by[a] != cm.killed_by[b]) return cm.killed_by[a] > cm.killed_by[b];
+      return a < b;
+    });
+    h.indices.resize(3 * nt);
+    h.killer.resize(nt);
+    for (std::size_t k = 0; k < nt; ++k) {
+      const glm::uvec3 f = mesh_triangle(m, perm[k]);
       h.indices[3 * k] = f.x, h.indices[3 * k + 1] = f.y, h.indices[3 * k + 2] = f.z;
-      h.killer[k] = cm.killed_by[t];
-      h.killer_owner[k] = cm.killed_by[t] == invalid_id ? 0 : h.owner[cm.killed_by[t]];
+      h.killer[k] = cm.killed_by[perm[k]];
     }
   }
   return h;

@@ -5,17 +5,19 @@
 // The paper iterates a shader maxContractionLevel times, each index following one contraction
 // per pass. Here the chains are resolved once per frame: walking the contractions from the last
 // to the first, remap[removed] = remap[target] if the contraction is applied, removed otherwise
-// (a target is removed only by a later contraction, so its entry is final when read). Then each
-// chunk of the cluster-ordered index buffer (chunks never straddle clusters) replaces every index
-// by its remap and drops triangles with a repeated index, writing compacted into its own slot of
-// the output in parallel; a serial pass moves the chunks together and records each cluster's
-// range (§IV.C binds one range per cluster). Chunk boundaries depend only on the hierarchy and
-// the grain, so the output has identical bits for any executor.
-// A triangle whose removing contraction (contraction_hierarchy::killer) is applied is skipped
-// without reading its indices: at dependency-closed stop points (neighbour matching's output,
-// or one global prefix) every earlier contraction that renamed its corners is a dependency of
-// that contraction and applied too, so the triangle is degenerate. This is a precondition:
-// stop points that are not dependency-closed may lose triangles that would not be degenerate.
+// (a target is removed only by a later contraction, so its entry is final when read).
+// Triangles are not tested one by one for removal: inside each cluster the hierarchy orders them
+// in runs by the owner of their removing contraction (contraction_hierarchy::killer), latest
+// removal first, so the triangles a frame keeps are a prefix of each run, found by binary search. At dependency-closed stop points (neighbour matching's
+// output, or one global prefix) a triangle whose removing contraction is applied is degenerate:
+// every earlier contraction that renamed its corners is a dependency of that contraction and
+// applied too. This is a precondition: stop points that are not dependency-closed may lose
+// triangles that would not be degenerate. Only the kept prefixes are read: each index replaced
+// by its remap, triangles with a repeated index dropped, written in parallel by fixed chunks
+// (never straddling a run) at offsets from a serial prefix sum; a serial pass closes the gaps
+// that dropped triangles leave and records each cluster's range (§IV.C binds one range per
+// cluster). Chunk boundaries depend only on the hierarchy and the grain, so the output has
+// identical bits for any executor.
 // One vertex map serves every cluster, so a vertex on a cluster border contracts the same way
 // in all of them (the paper ensures this with the shared-cluster texture).
 #include <algorithm>
@@ -38,13 +40,18 @@ struct index_range {
 // Indices the contraction pass may write: the full-resolution count. O(1).
 inline std::size_t contracted_index_bound(const contraction_hierarchy& h) { return h.indices.size(); }
 
-// Setup kept between frames: the vertex map and the chunk table. Build once per hierarchy
-// (O(V + T / grain) allocation); the per-frame calls then allocate nothing.
+// Setup kept between frames: the vertex map, the runs and the chunk table. Build once per
+// hierarchy (O(V + T / grain) allocation, O(T)); the per-frame calls then allocate nothing.
 struct contraction_workspace {
-  std::vector<std::uint32_t> remap;         // per vertex
-  std::vector<std::uint32_t> chunk_begin;   // per chunk: first triangle (cluster order), chunks + 1
-  std::vector<std::uint32_t> chunk_cluster; // per chunk
-  std::vector<std::uint32_t> chunk_count;   // per chunk: indices written this frame
+  std::vector<std::uint32_t> remap;          // per vertex
+  std::vector<std::uint32_t> run_begin;      // per run (triangles of one cluster removed by one owner), runs + 1
+  std::vector<std::uint32_t> run_owner;      // per run: the cluster owning its triangles' removing contractions
+  std::vector<std::uint32_t> run_kept;       // per run, this frame: one past its last kept triangle
+  std::vector<std::uint32_t> chunk_begin;    // per chunk (at most grain triangles of one run), chunks + 1
+  std::vector<std::uint32_t> chunk_run;      // per chunk
+  std::vector<std::uint32_t> chunk_cluster;  // per chunk
+  std::vector<std::size_t> chunk_at;         // per chunk, this frame: output offset if nothing is dropped
+  std::vector<std::uint32_t> chunk_count;    // per chunk, this frame: indices written
   std::size_t grain = 0;
 };
 
@@ -53,13 +60,23 @@ inline contraction_workspace make_contraction_workspace(const contraction_hierar
   w.grain = std::max<std::size_t>(grain, 1);
   w.remap.resize(h.vertex_count);
   for (std::uint32_t v = 0; v < h.vertex_count; ++v) w.remap[v] = v;
+  const auto run_of = [&](std::size_t t) { return h.killer[t] == invalid_id ? 0 : h.owner[h.killer[t]]; };
   for (std::uint32_t c = 0; c < h.cluster_count; ++c)
-    for (std::size_t t = h.triangle_offsets[c]; t < h.triangle_offsets[c + 1]; t += w.grain) {
-      w.chunk_begin.push_back(static_cast<std::uint32_t>(t));
-      w.chunk_cluster.push_back(c);
+    for (std::size_t t = h.triangle_offsets[c], e = t; t < h.triangle_offsets[c + 1]; t = e) {
+      while (e < h.triangle_offsets[c + 1] && run_of(e) == run_of(t)) ++e;
+      for (std::size_t b = t; b < e; b += w.grain) {
+        w.chunk_begin.push_back(static_cast<std::uint32_t>(b));
+        w.chunk_run.push_back(static_cast<std::uint32_t>(w.run_owner.size()));
+        w.chunk_cluster.push_back(c);
+      }
+      w.run_begin.push_back(static_cast<std::uint32_t>(t));
+      w.run_owner.push_back(run_of(t));
     }
+  w.run_begin.push_back(static_cast<std::uint32_t>(h.triangle_count()));
   w.chunk_begin.push_back(static_cast<std::uint32_t>(h.triangle_count()));
-  w.chunk_count.assign(w.chunk_cluster.size(), 0);
+  w.run_kept.assign(w.run_owner.size(), 0);
+  w.chunk_at.assign(w.chunk_run.size(), 0);
+  w.chunk_count.assign(w.chunk_run.size(), 0);
   return w;
 }
 
@@ -72,15 +89,17 @@ inline void resolve_vertex_map(const contraction_hierarchy& h, std::span<const s
   const std::uint32_t* owner = h.owner.data();
   std::uint32_t* remap = w.remap.data();
   for (std::size_t i = h.contraction_count(); i-- > 0;) {
-    const std::uint32_t u = removed[i];
-    remap[u] = i < stop[owner[i]] ? remap[target[i]] : u;
+    // A mask instead of a branch: per-cluster stop points make "applied" unpredictable.
+    const std::uint32_t u = removed[i], applied = 0u - static_cast<std::uint32_t>(i < stop[owner[i]]);
+    remap[u] = (remap[target[i]] & applied) | (u & ~applied);
   }
 }
 
 // Algorithm 1: the frame's index buffer into out (at least contracted_index_bound(h) entries)
 // and one range per cluster. Returns the indices written. Errors: out too small or ranges not
 // one per cluster (bad_size), stop not one per cluster (bad_size). Preconditions: w from this
-// hierarchy; stop dependency-closed (see the top of the file). O(T / threads + chunks), no allocation unless an error is returned; identical bits
+// hierarchy; stop dependency-closed (see the top of the file). O(contractions + runs · log T +
+// kept triangles / threads + chunks), no allocation unless an error is returned; identical bits
 // for any executor.
 template <class E = serial_executor>
 result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
@@ -94,18 +113,27 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
     return make_error(errc::bad_size, ranges.size(), "stop and ranges hold ", stop.size(), " and ", ranges.size(),
                       " entries for ", h.cluster_count, " clusters");
   resolve_vertex_map(h, stop, w);
+  for (std::size_t r = 0; r < w.run_owner.size(); ++r) {  // kept: removing contraction >= the owner's stop
+    const std::uint32_t s = stop[w.run_owner[r]];
+    const auto b = h.killer.begin() + w.run_begin[r], e = h.killer.begin() + w.run_begin[r + 1];
+    w.run_kept[r] = static_cast<std::uint32_t>(std::partition_point(b, e, [s](std::uint32_t k) { return k >= s; }) -
+                                               h.killer.begin());
+  }
+  std::size_t planned = 0;
+  for (std::size_t k = 0; k < w.chunk_run.size(); ++k) {
+    w.chunk_at[k] = planned;
+    const std::uint32_t e = std::min(w.chunk_begin[k + 1], w.run_kept[w.chunk_run[k]]);
+    planned += 3 * std::size_t{e > w.chunk_begin[k] ? e - w.chunk_begin[k] : 0};
+  }
   const std::uint32_t* remap = w.remap.data();
   const std::uint32_t* src = h.indices.data();
-  const std::uint32_t* killer = h.killer.data();
-  const std::uint32_t* killer_owner = h.killer_owner.data();
-  const std::uint32_t* stops = stop.data();
   std::uint32_t* dst = out.data();
-  exec.parallel_for(w.chunk_cluster.size(), 1, [&](std::size_t b, std::size_t e) {
+  exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
-      std::uint32_t* o = dst + 3 * std::size_t{w.chunk_begin[k]};
+      std::uint32_t* o = dst + w.chunk_at[k];
       std::uint32_t* const o0 = o;
-      for (std::size_t t = w.chunk_begin[k]; t < w.chunk_begin[k + 1]; ++t) {
-        if (killer[t] < stops[killer_owner[t]]) continue;  // removed (see the top of the file)
+      const std::size_t end = std::min(w.chunk_begin[k + 1], w.run_kept[w.chunk_run[k]]);
+      for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
         const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
         o[0] = a, o[1] = bb, o[2] = c;
         o += (a != bb && bb != c && a != c) ? 3 : 0;
@@ -115,11 +143,11 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
   });
   std::size_t at = 0;
   for (std::uint32_t c = 0; c < h.cluster_count; ++c) ranges[c] = {0, 0};
-  for (std::size_t k = 0; k < w.chunk_cluster.size(); ++k) {
-    const std::size_t from = 3 * std::size_t{w.chunk_begin[k]};
+  for (std::size_t k = 0; k < w.chunk_run.size(); ++k) {
     index_range& r = ranges[w.chunk_cluster[k]];
     if (r.count == 0) r.first = static_cast<std::uint32_t>(at);
-    if (from != at && w.chunk_count[k]) std::memmove(dst + at, dst + from, sizeof(std::uint32_t) * w.chunk_count[k]);
+    if (w.chunk_at[k] != at && w.chunk_count[k])
+      std::memmove(dst + at, dst + w.chunk_at[k], sizeof(std::uint32_t) * w.chunk_count[k]);
     at += w.chunk_count[k];
     r.count += w.chunk_count[k];
   }

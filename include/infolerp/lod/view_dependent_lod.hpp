@@ -64,7 +64,7 @@ class view_dependent_lod {
 
   // One frame. Errors: a non-finite camera, a camera inside every cluster's bounding sphere,
   // global_contractions > capacity() (bad_parameter); out smaller than contracted_index_bound
-  // or ranges not one per cluster (bad_size). O(C log C + contractions + T / threads).
+  // or ranges not one per cluster (bad_size). O(C log C + contractions + kept triangles / threads).
   template <class E = serial_executor>
   result<lod_frame_stats> frame(const glm::dvec3& camera, std::uint64_t global_contractions,
                                 std::span<std::uint32_t> out, std::span<index_range> ranges, E&& exec = E{}) {
