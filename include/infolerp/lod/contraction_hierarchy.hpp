@@ -20,9 +20,10 @@
 // contraction (cross_dependency). A cluster's capacity is the contractions it owns.
 //
 // Preconditions: an edge-manifold mesh, finite positions (both checked).
-// Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
-// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
-// cross-cluster dependency, 20 per triangle, 4 per vertex.
+// Complexity: O(T log T) heap work plus O(valence²) per contraction; the cost is mostly cache
+// misses on the neighbourhoods the global order visits. Allocation: about 150 bytes per
+// triangle during the build; the result keeps 21 bytes per contraction, 12 per cross-cluster
+// dependency, 20 per triangle, 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -184,48 +185,48 @@ class vertex_heap {
   std::vector<std::uint32_t> slot_;
 };
 
-// The mutable mesh of the build: triangles, each vertex's live triangles as a slice of one flat
-// array (vertex → triangle adjacency in CSR form; a dead triangle leaves its corners' slices at
-// once, and a slice that outgrows its room moves to the end of the array), and quadrics.
+// Triangle t seen from its corner j (vertex x): corner = 3t + j; a and b are the vertices of
+// corners j + 1 and j + 2, so that x's neighbours are read without looking up the triangle.
+struct fan_entry {
+  std::uint32_t corner, a, b;
+};
+
+// The mutable mesh of the build: each vertex's live triangles as a slice of one flat array
+// (vertex → triangle adjacency in CSR form; a dead triangle leaves its corners' slices at once,
+// and a slice that outgrows its room moves to the end of the array), and quadrics.
 class collapse_mesh {
  public:
   static constexpr std::uint32_t nil = invalid_id;
-  std::vector<glm::dvec3> pos;
-  std::vector<glm::uvec3> tri;
+  std::vector<glm::vec3> pos;  // as given (exact in double)
   std::vector<char> alive, boundary;
-  std::vector<std::uint32_t> fan;                // the slices
+  std::vector<fan_entry> fan;                     // the slices
   std::vector<std::uint32_t> first, count, room;  // vertex x's slice: fan[first[x] ..+ count[x]), room[x] long
   std::vector<std::uint32_t> stamp, last_touch, killed_by;
   std::vector<quadric> q;
   std::uint32_t stamp_now = 0;
   std::vector<std::uint32_t> ring_u, ring_v;
 
-  [[nodiscard]] std::span<const std::uint32_t> triangles(std::uint32_t x) const { return {fan.data() + first[x], count[x]}; }
+  [[nodiscard]] glm::dvec3 at(std::uint32_t x) const { return glm::dvec3(pos[x]); }
+  [[nodiscard]] std::span<const fan_entry> triangles(std::uint32_t x) const { return {fan.data() + first[x], count[x]}; }
   // Distinct neighbours of x into out, each marked with a fresh stamp.
   void ring(std::uint32_t x, std::vector<std::uint32_t>& out) {
     out.clear();
     const std::uint32_t s = ++stamp_now;
-    for (std::uint32_t t : triangles(x))
-      for (int j = 0; j < 3; ++j) {
-        const std::uint32_t y = tri[t][j];
-        if (y != x && stamp[y] != s) stamp[y] = s, out.push_back(y);
-      }
+    for (const fan_entry& e : triangles(x)) {
+      if (stamp[e.a] != s) stamp[e.a] = s, out.push_back(e.a);
+      if (stamp[e.b] != s) stamp[e.b] = s, out.push_back(e.b);
+    }
   }
   // The §III.C validity tests for u → v (see the top of the file). When they pass, ring(u) is in
-  // ring_u and ring(v) in ring_v.
+  // ring_u and ring(v) in ring_v, the latter marked with stamp_now.
   bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
     std::uint32_t opp[2] = {nil, nil}, k = 0;  // the triangles on the edge and their third corners
-    ring_u.clear();
-    const std::uint32_t su = ++stamp_now;
-    for (std::uint32_t t : triangles(u)) {
-      const glm::uvec3 f = tri[t];
-      if (f.x == v || f.y == v || f.z == v) {
-        if (k < 2) opp[k] = f.x != u && f.x != v ? f.x : (f.y != u && f.y != v ? f.y : f.z);
+    ring(u, ring_u);
+    for (const fan_entry& e : triangles(u))
+      if (e.a == v || e.b == v) {
+        if (k < 2) opp[k] = e.a == v ? e.b : e.a;
         ++k;
       }
-      for (int j = 0; j < 3; ++j)
-        if (f[j] != u && stamp[f[j]] != su) stamp[f[j]] = su, ring_u.push_back(f[j]);
-    }
     if (k == 0 || k > 2) return false;
     if (boundary[u] && !(boundary[v] && k == 1)) return false;
     ring(v, ring_v);
@@ -233,25 +234,19 @@ class collapse_mesh {
     // Link condition: a common neighbour must be opposite the edge.
     for (std::uint32_t x : ring_u)
       if (x != v && stamp[x] == sv && x != opp[0] && x != opp[1]) return false;
-    const glm::dvec3 pv = pos[v];
-    for (std::uint32_t t : triangles(u)) {
-      const glm::uvec3 f = tri[t];
-      if (f.x == v || f.y == v || f.z == v) continue;
-      glm::dvec3 p[3] = {pos[f.x], pos[f.y], pos[f.z]};
+    for (const fan_entry& e : triangles(u)) {
+      if (e.a == v || e.b == v) continue;
+      const std::uint32_t j = e.corner % 3;
+      glm::dvec3 p[3];
+      p[j] = at(u), p[(j + 1) % 3] = at(e.a), p[(j + 2) % 3] = at(e.b);
       const glm::dvec3 n0 = glm::cross(p[1] - p[0], p[2] - p[0]);
-      for (int j = 0; j < 3; ++j)
-        if (f[j] == u) p[j] = pv;
+      p[j] = at(v);
       const glm::dvec3 n1 = glm::cross(p[1] - p[0], p[2] - p[0]);
       if (!(glm::dot(n0, n1) > min_cos * glm::length(n0) * glm::length(n1))) return false;
       // A duplicate triangle (v, a, b) would appear when v already has one on a and b.
-      std::uint32_t a = nil, b = nil;
-      for (int j = 0; j < 3; ++j)
-        if (f[j] != u) (a == nil ? a : b) = f[j];
-      if (k == 2 && (a == opp[0] || a == opp[1]) && (b == opp[0] || b == opp[1]))
-        for (std::uint32_t s : triangles(v)) {
-          const glm::uvec3 g = tri[s];
-          if ((g.x == a || g.y == a || g.z == a) && (g.x == b || g.y == b || g.z == b)) return false;
-        }
+      if (k == 2 && (e.a == opp[0] || e.a == opp[1]) && (e.b == opp[0] || e.b == opp[1]))
+        for (const fan_entry& g : triangles(v))
+          if ((g.a == e.a || g.b == e.a) && (g.a == e.b || g.b == e.b)) return false;
     }
     return true;
   }
@@ -261,26 +256,24 @@ class collapse_mesh {
     std::uint32_t kept = 0;
     const std::uint32_t fu = first[u];
     for (std::uint32_t i = 0; i < count[u]; ++i) {
-      const std::uint32_t t = fan[fu + i];
-      glm::uvec3& f = tri[t];
-      if (f.x == v || f.y == v || f.z == v) {
+      const fan_entry e = fan[fu + i];
+      const std::uint32_t t = e.corner / 3;
+      if (e.a == v || e.b == v) {
         killed_by[t] = order;
         ++removed;
-        for (int j = 0; j < 3; ++j)
-          if (f[j] != u) drop(f[j], t);
+        drop(e.a, t), drop(e.b, t);
         continue;
       }
-      for (int j = 0; j < 3; ++j)
-        if (f[j] == u) f[j] = v;
-      fan[fu + kept++] = t;
+      rename(e.a, t, u, v), rename(e.b, t, u, v);
+      fan[fu + kept++] = e;
     }
     // u's surviving triangles join v's slice.
     const std::uint32_t need = count[v] + kept;
     if (need > room[v]) {
-      const auto at = static_cast<std::uint32_t>(fan.size());
+      const auto end = static_cast<std::uint32_t>(fan.size());
       fan.resize(fan.size() + need + need / 2);
-      std::copy_n(fan.begin() + first[v], count[v], fan.begin() + at);
-      first[v] = at, room[v] = need + need / 2;
+      std::copy_n(fan.begin() + first[v], count[v], fan.begin() + end);
+      first[v] = end, room[v] = need + need / 2;
     }
     std::copy_n(fan.begin() + fu, kept, fan.begin() + first[v] + count[v]);
     count[v] = need, count[u] = 0;
@@ -290,11 +283,15 @@ class collapse_mesh {
   }
 
  private:
-  void drop(std::uint32_t x, std::uint32_t t) {  // t leaves x's slice (order within a slice is free)
-    std::uint32_t* s = fan.data() + first[x];
-    std::uint32_t i = 0;
-    while (s[i] != t) ++i;
-    s[i] = s[--count[x]];
+  fan_entry* find(std::uint32_t x, std::uint32_t t) {  // triangle t in x's slice
+    fan_entry* e = fan.data() + first[x];
+    while (e->corner / 3 != t) ++e;
+    return e;
+  }
+  void drop(std::uint32_t x, std::uint32_t t) { *find(x, t) = fan[first[x] + --count[x]]; }  // order within a slice is free
+  void rename(std::uint32_t x, std::uint32_t t, std::uint32_t from, std::uint32_t to) {
+    fan_entry* e = find(x, t);
+    (e->a == from ? e->a : e->b) = to;
   }
 };
 
@@ -338,8 +335,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
 
   detail::collapse_mesh cm;
   cm.pos.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = glm::dvec3(mesh_position(m, v));
-  cm.tri.resize(nt);
+  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = mesh_position(m, v);
   cm.killed_by.assign(nt, invalid_id);
   cm.alive.assign(nv, 0);
   cm.boundary.assign(nv, 0);
@@ -350,7 +346,6 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   bool repeated = false;
   for (std::size_t t = nt; t-- > 0;) {
     const glm::uvec3 f = mesh_triangle(m, t);
-    cm.tri[t] = f;
     if (f.x == f.y || f.y == f.z || f.x == f.z) {
       repeated = true;  // a repeated index draws nothing; it counts for the edges below only
       continue;
@@ -359,7 +354,7 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       cm.alive[f[j]] = 1;
       owner[f[j]] = cluster[t];  // last write wins: the lowest-index triangle
     }
-    const glm::dvec3 p0 = cm.pos[f.x], p1 = cm.pos[f.y], p2 = cm.pos[f.z];
+    const glm::dvec3 p0 = cm.at(f.x), p1 = cm.at(f.y), p2 = cm.at(f.z);
     const glm::dvec3 n2 = glm::cross(p1 - p0, p2 - p0);
     const double len = glm::length(n2);
     if (!(len > 0.0)) continue;
@@ -373,15 +368,19 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   // Vertex → triangle adjacency, ascending triangle ids, every triangle under each distinct corner.
   auto distinct = [](const glm::uvec3& f, int j) { return j == 0 || (f[j] != f.x && (j == 1 || f.z != f.y)); };
   cm.first.assign(nv + 1, 0);
-  for (const glm::uvec3& f : cm.tri)
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::uvec3 f = mesh_triangle(m, t);
     for (int j = 0; j < 3; ++j)
       if (distinct(f, j)) ++cm.first[f[j] + 1];
+  }
   for (std::size_t v = 0; v < nv; ++v) cm.first[v + 1] += cm.first[v];
   cm.fan.resize(cm.first[nv]);
   cm.count.assign(nv, 0);
-  for (std::uint32_t t = 0; t < nt; ++t)
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    const glm::uvec3 f = mesh_triangle(m, t);
     for (int j = 0; j < 3; ++j)
-      if (const std::uint32_t x = cm.tri[t][j]; distinct(cm.tri[t], j)) cm.fan[cm.first[x] + cm.count[x]++] = t;
+      if (distinct(f, j)) cm.fan[cm.first[f[j]] + cm.count[f[j]]++] = {3 * t + static_cast<std::uint32_t>(j), f[(j + 1) % 3], f[(j + 2) % 3]};
+  }
   // Edges (a, b), a < b, from a's triangles in ascending (a, b): more than two distinct triangles
   // is an error; one makes a boundary edge, held by a plane through it perpendicular to its
   // (lowest-index) triangle.
@@ -390,13 +389,15 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     for (std::uint32_t a = 0; a < nv; ++a) {
       const std::uint32_t s = ++cm.stamp_now;
       others.clear();
-      for (std::uint32_t t : cm.triangles(a))
-        for (int j = 0; j < 3; ++j) {
-          const std::uint32_t b = cm.tri[t][j];
-          if (b <= a || !distinct(cm.tri[t], j)) continue;
-          if (cm.stamp[b] != s) cm.stamp[b] = s, hits[b] = 0, edge_tri[b] = t, others.push_back(b);
-          ++hits[b];
-        }
+      auto hit = [&](std::uint32_t b, std::uint32_t t) {
+        if (b <= a) return;
+        if (cm.stamp[b] != s) cm.stamp[b] = s, hits[b] = 0, edge_tri[b] = t, others.push_back(b);
+        ++hits[b];
+      };
+      for (const detail::fan_entry& e : cm.triangles(a)) {
+        hit(e.a, e.corner / 3);
+        if (e.b != e.a) hit(e.b, e.corner / 3);  // a triangle counts once per edge
+      }
       std::sort(others.begin(), others.end());
       open.clear();
       for (std::uint32_t b : others) {
@@ -407,14 +408,14 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       for (std::uint32_t b : open) {
         cm.boundary[a] = cm.boundary[b] = 1;
         const std::uint32_t t = edge_tri[b];
-        const glm::uvec3 f = cm.tri[t];
-        const glm::dvec3 fn = glm::cross(cm.pos[f.y] - cm.pos[f.x], cm.pos[f.z] - cm.pos[f.x]);
-        const glm::dvec3 ev = cm.pos[b] - cm.pos[a];
+        const glm::uvec3 f = mesh_triangle(m, t);
+        const glm::dvec3 fn = glm::cross(cm.at(f.y) - cm.at(f.x), cm.at(f.z) - cm.at(f.x));
+        const glm::dvec3 ev = cm.at(b) - cm.at(a);
         const glm::dvec3 pn = glm::cross(ev, fn);
         const double len = glm::length(pn);
         if (!(len > 0.0)) continue;
         const glm::dvec3 n = pn / len;
-        const double d = -glm::dot(n, cm.pos[a]);
+        const double d = -glm::dot(n, cm.at(a));
         const double w = opt.boundary_weight * glm::dot(ev, ev) * (weights[3 * t] + weights[3 * t + 1] + weights[3 * t + 2]) / 3.0;
         cm.q[a].add_plane(n, d, w);
         cm.q[b].add_plane(n, d, w);
@@ -426,8 +427,8 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     for (std::uint32_t v = 0; v < nv; ++v) {
       std::uint32_t kept = 0;
       for (std::uint32_t i = 0; i < cm.count[v]; ++i) {
-        const glm::uvec3 f = cm.tri[cm.fan[cm.first[v] + i]];
-        if (f.x != f.y && f.y != f.z && f.x != f.z) cm.fan[cm.first[v] + kept++] = cm.fan[cm.first[v] + i];
+        const detail::fan_entry e = cm.fan[cm.first[v] + i];
+        if (e.a != e.b && e.a != v && e.b != v) cm.fan[cm.first[v] + kept++] = e;
       }
       cm.count[v] = kept;
     }
@@ -451,10 +452,10 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   // candidates of v's neighbours (u is gone, v may be new), whose entries are updated.
   detail::vertex_heap heap;
   heap.reset(nv);
-  std::vector<std::uint32_t> candidates;
+  std::vector<std::uint32_t> candidates, joining;
   std::vector<std::pair<double, std::uint32_t>> ranked;
   std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
-  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.pos[v]); };
+  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.at(v)); };
   // u's entry from its neighbours (ring(u)).
   auto rank = [&](std::uint32_t u, const std::vector<std::uint32_t>& ring) {
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
@@ -512,6 +513,9 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       continue;
     }
     heap.erase(e.u);
+    joining.clear();  // the neighbours of u that v gains
+    for (std::uint32_t x : cm.ring_u)
+      if (x != e.v && cm.stamp[x] != cm.stamp_now) joining.push_back(x);
     // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
     const auto order = static_cast<std::uint32_t>(h.removed.size());
     std::uint32_t parent = no_parent;
@@ -541,14 +545,14 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     cm.ring(e.v, cm.ring_v);
     rank(e.v, cm.ring_v);
     // A neighbour x of v: x → u vanished and x → v may be new (its cost depends on Q_x and p_v
-    // only); an entry not aiming at u stays exact unless x → v beats it. A vertex without an
-    // entry or with a fallback one is ranked anew: its refused contractions may pass now.
+    // only); an entry not aiming at u stays exact unless x joined v and x → v beats it. A vertex
+    // without an entry or with a fallback one is ranked anew: its refused contractions may pass.
     for (std::uint32_t x : cm.ring_v) {
       const detail::collapse_entry* old = heap.find(x);
       if (!old || fallback[x] || old->v == e.u) {
         set_best(x);
-      } else if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) {
-        heap.set(to_v);
+      } else if (std::find(joining.begin(), joining.end(), x) != joining.end()) {
+        if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) heap.set(to_v);
       }
     }
   }
