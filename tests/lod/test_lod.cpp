@@ -264,6 +264,74 @@ TEST_CASE("vertex contraction: the triangles a cluster keeps are prefixes of run
   CHECK(dropped > 0);
 }
 
+TEST_CASE("hierarchy on a bumpy plane with holes: no flip, boundary kept, manifold", "[lod]") {
+  indexed_mesh m = support::make_plane(14, 11, 2.0f);
+  for (auto& p : m.positions) p.z = 0.15f * std::sin(4.0f * p.x) * std::cos(3.0f * p.y);
+  std::vector<glm::uvec3> kept;  // two holes and a notch in the rim
+  for (std::size_t t = 0; t < m.triangle_count(); ++t)
+    if (t % 37 != 5 && t % 53 != 20 && t != 1) kept.push_back(m.triangles[t]);
+  m.triangles = kept;
+  m.triangles.push_back({3, 3, 4});  // a repeated index draws nothing
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const glm::uvec3& f : m.triangles)
+    if (f.x != f.y && f.y != f.z && f.x != f.z)
+      for (int j = 0; j < 3; ++j) ++uses[{std::min(f[j], f[(j + 1) % 3]), std::max(f[j], f[(j + 1) % 3])}];
+  std::vector<char> on_boundary(m.vertex_count(), 0);
+  for (const auto& [e, n] : uses)
+    if (n == 1) on_boundary[e.first] = on_boundary[e.second] = 1;
+  const std::vector<std::uint32_t> cl(m.triangle_count(), 0);
+  const std::vector<double> w(3 * m.triangle_count(), 1.0);
+  // No boundary planes: only the boundary rule keeps the rim.
+  auto h = build_contraction_hierarchy(m, w, cl, 1, {.backstop = 0.0, .boundary_weight = 0.0});
+  REQUIRE(h.ok());
+  REQUIRE(h->contraction_count() > m.vertex_count() / 2);
+  // Replay the contractions one by one on a vertex map.
+  std::vector<std::uint32_t> to(m.vertex_count());
+  for (std::uint32_t v = 0; v < to.size(); ++v) to[v] = v;
+  auto normal = [&](std::size_t t) {
+    const glm::dvec3 a(m.positions[to[h->indices[3 * t]]]), b(m.positions[to[h->indices[3 * t + 1]]]),
+        c(m.positions[to[h->indices[3 * t + 2]]]);
+    return glm::cross(b - a, c - a);
+  };
+  std::size_t flips = 0, off_boundary = 0, non_manifold = 0;
+  for (std::uint32_t i = 0; i < h->contraction_count(); ++i) {
+    const std::uint32_t u = h->removed[i], v = h->target[i];
+    if (on_boundary[u] && !on_boundary[v]) ++off_boundary;
+    std::vector<glm::dvec3> before(h->triangle_count());
+    for (std::size_t t = 0; t < before.size(); ++t) before[t] = normal(t);
+    for (auto& x : to)
+      if (x == u) x = v;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+    for (std::size_t t = 0; t < before.size(); ++t) {
+      const std::uint32_t a = to[h->indices[3 * t]], b = to[h->indices[3 * t + 1]], c = to[h->indices[3 * t + 2]];
+      if (a == b || b == c || a == c) continue;
+      if (!(glm::dot(before[t], normal(t)) > 0.0)) ++flips;
+      for (auto [x, y] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) ++edges[{std::min(x, y), std::max(x, y)}];
+    }
+    for (const auto& [e, n] : edges) {
+      if (n > 2) ++non_manifold;
+      if (n == 1 && !(on_boundary[e.first] && on_boundary[e.second])) ++off_boundary;
+    }
+  }
+  CHECK(flips == 0);
+  CHECK(off_boundary == 0);
+  CHECK(non_manifold == 0);
+}
+
+TEST_CASE("hierarchy: a non-manifold edge is refused and named", "[lod]") {
+  indexed_mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {2, 2, 2}};
+  m.triangles = {{5, 2, 4}, {0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // edge (0, 1) has three triangles
+  const std::vector<double> w(3 * m.triangle_count(), 1.0);
+  const std::vector<std::uint32_t> cl(m.triangle_count(), 0);
+  auto h = build_contraction_hierarchy(m, w, cl, 1);
+  REQUIRE(!h.ok());
+  CHECK(h.error().code() == errc::non_manifold_edge);
+  CHECK(h.error().element() == 0);
+  m.triangles.pop_back();
+  CHECK(build_contraction_hierarchy(m, std::span(w).first(9), std::span(cl).first(3), 1).ok());
+}
+
 TEST_CASE("vertex contraction: identical bits for any executor", "[lod]") {
   const indexed_mesh m = support::make_icosphere(3);
   const std::vector<std::uint32_t> cl = octant_clusters(m);

@@ -20,9 +20,10 @@
 // contraction (cross_dependency). A cluster's capacity is the contractions it owns.
 //
 // Preconditions: an edge-manifold mesh, finite positions (both checked).
-// Complexity: O(T log T) heap work plus O(valence²) per contraction. Allocation: about 200
-// bytes per triangle during the build; the result keeps 21 bytes per contraction, 12 per
-// cross-cluster dependency, 16 per triangle, 4 per vertex.
+// Complexity: O(T log T) heap work plus O(valence²) per contraction, mostly scattered memory
+// accesses since the global order jumps across the mesh. Allocation: about 150 bytes per
+// triangle during the build; the result keeps 21 bytes per contraction, 12 per cross-cluster
+// dependency, 16 per triangle, 4 per vertex.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -36,7 +37,6 @@
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
-#include "infolerp/mesh/topology.hpp"
 
 namespace infolerp {
 
@@ -186,119 +186,113 @@ class vertex_heap {
   std::vector<std::uint32_t> slot_;
 };
 
-// The mutable mesh of the build: triangles with per-vertex corner lists (singly linked, dead
-// triangles unlinked lazily) and quadrics.
+// Triangle t seen from its corner j (vertex x): corner = 3t + j; a and b are the vertices of
+// corners j + 1 and j + 2, so that x's neighbours are read without looking up the triangle.
+struct fan_entry {
+  std::uint32_t corner, a, b;
+};
+
+// The mutable mesh of the build: each vertex's live triangles as a slice of one flat array
+// (vertex → triangle adjacency in CSR form; a dead triangle leaves its corners' slices at once,
+// and a slice that outgrows its room moves to the end of the array), and quadrics.
 class collapse_mesh {
  public:
   static constexpr std::uint32_t nil = invalid_id;
-  std::vector<glm::dvec3> pos;
-  std::vector<glm::uvec3> tri;
-  std::vector<char> tri_alive, alive, boundary;
-  std::vector<std::uint32_t> head, next, stamp, last_touch, killed_by;
+  std::vector<glm::vec3> pos;  // as given (exact in double)
+  std::vector<char> alive, boundary;
+  std::vector<fan_entry> fan;                     // the slices
+  std::vector<std::uint32_t> first, count, room;  // vertex x's slice: fan[first[x] ..+ count[x]), room[x] long
+  std::vector<std::uint32_t> stamp, last_touch, killed_by;
   std::vector<quadric> q;
   std::uint32_t stamp_now = 0;
   std::vector<std::uint32_t> ring_u, ring_v;
 
-  // Calls f(t) for every live triangle of x, unlinking dead ones on the way.
-  template <class F>
-  void for_each_triangle(std::uint32_t x, F&& f) {
-    std::uint32_t* link = &head[x];
-    while (*link != nil) {
-      const std::uint32_t c = *link;
-      if (!tri_alive[c / 3]) {
-        *link = next[c];
-        continue;
-      }
-      f(c / 3);
-      link = &next[c];
-    }
-  }
+  [[nodiscard]] glm::dvec3 at(std::uint32_t x) const { return glm::dvec3(pos[x]); }
+  [[nodiscard]] std::span<const fan_entry> triangles(std::uint32_t x) const { return {fan.data() + first[x], count[x]}; }
   // Distinct neighbours of x into out, each marked with a fresh stamp.
   void ring(std::uint32_t x, std::vector<std::uint32_t>& out) {
     out.clear();
     const std::uint32_t s = ++stamp_now;
-    for_each_triangle(x, [&](std::uint32_t t) {
-      for (int j = 0; j < 3; ++j) {
-        const std::uint32_t y = tri[t][j];
-        if (y != x && stamp[y] != s) stamp[y] = s, out.push_back(y);
-      }
-    });
+    for (const fan_entry& e : triangles(x)) {
+      if (stamp[e.a] != s) stamp[e.a] = s, out.push_back(e.a);
+      if (stamp[e.b] != s) stamp[e.b] = s, out.push_back(e.b);
+    }
   }
-  std::uint32_t shared_triangles(std::uint32_t u, std::uint32_t v, std::uint32_t opp[2]) {
-    std::uint32_t k = 0;
-    for_each_triangle(u, [&](std::uint32_t t) {
-      const glm::uvec3 f = tri[t];
-      if (f.x != v && f.y != v && f.z != v) return;
-      if (k < 2) opp[k] = f.x != u && f.x != v ? f.x : (f.y != u && f.y != v ? f.y : f.z);
-      ++k;
-    });
-    return k;
-  }
-  // The §III.C validity tests for u → v (see the top of the file). Leaves ring(u) in ring_u,
-  // ring(v) in ring_v.
+  // The §III.C validity tests for u → v (see the top of the file). When they pass, ring(u) is in
+  // ring_u and ring(v) in ring_v, the latter marked with stamp_now.
   bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
-    std::uint32_t opp[2] = {nil, nil};
-    const std::uint32_t k = shared_triangles(u, v, opp);
+    std::uint32_t opp[2] = {nil, nil}, k = 0;  // the triangles on the edge and their third corners
+    ring(u, ring_u);
+    for (const fan_entry& e : triangles(u))
+      if (e.a == v || e.b == v) {
+        if (k < 2) opp[k] = e.a == v ? e.b : e.a;
+        ++k;
+      }
     if (k == 0 || k > 2) return false;
     if (boundary[u] && !(boundary[v] && k == 1)) return false;
-    ring(u, ring_u);
     ring(v, ring_v);
     const std::uint32_t sv = stamp_now;  // ring(v) carries this stamp
     // Link condition: a common neighbour must be opposite the edge.
     for (std::uint32_t x : ring_u)
       if (x != v && stamp[x] == sv && x != opp[0] && x != opp[1]) return false;
-    bool ok = true;
-    const glm::dvec3 pv = pos[v];
-    for_each_triangle(u, [&](std::uint32_t t) {
-      if (!ok) return;
-      const glm::uvec3 f = tri[t];
-      if (f.x == v || f.y == v || f.z == v) return;
-      glm::dvec3 p[3] = {pos[f.x], pos[f.y], pos[f.z]};
+    for (const fan_entry& e : triangles(u)) {
+      if (e.a == v || e.b == v) continue;
+      const std::uint32_t j = e.corner % 3;
+      glm::dvec3 p[3];
+      p[j] = at(u), p[(j + 1) % 3] = at(e.a), p[(j + 2) % 3] = at(e.b);
       const glm::dvec3 n0 = glm::cross(p[1] - p[0], p[2] - p[0]);
-      for (int j = 0; j < 3; ++j)
-        if (f[j] == u) p[j] = pv;
+      p[j] = at(v);
       const glm::dvec3 n1 = glm::cross(p[1] - p[0], p[2] - p[0]);
-      if (!(glm::dot(n0, n1) > min_cos * glm::length(n0) * glm::length(n1))) ok = false;
+      if (!(glm::dot(n0, n1) > min_cos * glm::length(n0) * glm::length(n1))) return false;
       // A duplicate triangle (v, a, b) would appear when v already has one on a and b.
-      std::uint32_t a = nil, b = nil;
-      for (int j = 0; j < 3; ++j)
-        if (f[j] != u) (a == nil ? a : b) = f[j];
-      if (k == 2 && (a == opp[0] || a == opp[1]) && (b == opp[0] || b == opp[1]))
-        for_each_triangle(v, [&](std::uint32_t s) {
-          const glm::uvec3 g = tri[s];
-          const bool has_a = g.x == a || g.y == a || g.z == a, has_b = g.x == b || g.y == b || g.z == b;
-          if (has_a && has_b) ok = false;
-        });
-    });
-    return ok;
+      if (k == 2 && (e.a == opp[0] || e.a == opp[1]) && (e.b == opp[0] || e.b == opp[1]))
+        for (const fan_entry& g : triangles(v))
+          if ((g.a == e.a || g.b == e.a) && (g.a == e.b || g.b == e.b)) return false;
+    }
+    return true;
   }
   // Performs u → v as contraction `order`; returns the triangles removed (killed_by names it).
   std::uint8_t collapse(std::uint32_t u, std::uint32_t v, std::uint32_t order) {
     std::uint8_t removed = 0;
-    std::uint32_t last = nil;
-    for_each_triangle(u, [&](std::uint32_t t) {
-      glm::uvec3& f = tri[t];
-      if (f.x == v || f.y == v || f.z == v) {
-        tri_alive[t] = 0;
+    std::uint32_t kept = 0;
+    const std::uint32_t fu = first[u];
+    for (std::uint32_t i = 0; i < count[u]; ++i) {
+      const fan_entry e = fan[fu + i];
+      const std::uint32_t t = e.corner / 3;
+      if (e.a == v || e.b == v) {
         killed_by[t] = order;
         ++removed;
-        return;
+        drop(e.a, t), drop(e.b, t);
+        continue;
       }
-      for (int j = 0; j < 3; ++j)
-        if (f[j] == u) f[j] = v, last = 3 * t + static_cast<std::uint32_t>(j);
-    });
-    // Splice u's (live) corners in front of v's.
-    if (last != nil) {
-      // Walk to the end of u's list: dead entries may remain after `last`, so find the tail.
-      std::uint32_t c = head[u];
-      while (next[c] != nil) c = next[c];
-      next[c] = head[v];
-      head[v] = head[u];
+      rename(e.a, t, u, v), rename(e.b, t, u, v);
+      fan[fu + kept++] = e;
     }
-    head[u] = nil;
+    // u's surviving triangles join v's slice.
+    const std::uint32_t need = count[v] + kept;
+    if (need > room[v]) {
+      const auto end = static_cast<std::uint32_t>(fan.size());
+      fan.resize(fan.size() + need + need / 2);
+      std::copy_n(fan.begin() + first[v], count[v], fan.begin() + end);
+      first[v] = end, room[v] = need + need / 2;
+    }
+    std::copy_n(fan.begin() + fu, kept, fan.begin() + first[v] + count[v]);
+    count[v] = need, count[u] = 0;
     alive[u] = 0;
     q[v] += q[u];
     return removed;
+  }
+
+ private:
+  fan_entry* find(std::uint32_t x, std::uint32_t t) {  // triangle t in x's slice
+    fan_entry* e = fan.data() + first[x];
+    while (e->corner / 3 != t) ++e;
+    return e;
+  }
+  void drop(std::uint32_t x, std::uint32_t t) { *find(x, t) = fan[first[x] + --count[x]]; }  // order within a slice is free
+  void rename(std::uint32_t x, std::uint32_t t, std::uint32_t from, std::uint32_t to) {
+    fan_entry* e = find(x, t);
+    (e->a == from ? e->a : e->b) = to;
   }
 };
 
@@ -337,42 +331,31 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     return make_error(errc::bad_parameter, no_element, "min_normal_cos ", opt.min_normal_cos, " must be in [0, 1)");
   if (!(opt.boundary_weight >= 0.0) || !std::isfinite(opt.boundary_weight))
     return make_error(errc::bad_parameter, no_element, "boundary_weight ", opt.boundary_weight, " must be >= 0 and finite");
-  auto topo = build_topology(m);
-  if (!topo.ok()) return topo.error();
-  for (std::size_t e = 0; e < topo->edge_count(); ++e)
-    if (topo->is_non_manifold_edge(e))
-      return make_error(errc::non_manifold_edge, topo->edges[e].x, "edge (", topo->edges[e].x, ", ", topo->edges[e].y,
-                        ") has ", topo->edge_valence(e), " triangles");
+  if (nt >= (std::size_t{1} << 32) / 3 || nv >= invalid_id)
+    return make_error(errc::unsupported, nt, "mesh has ", nv, " vertices and ", nt, " triangles; at most 4294967294 and 1431655764 are supported");
 
   detail::collapse_mesh cm;
   cm.pos.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = glm::dvec3(mesh_position(m, v));
-  cm.tri.resize(nt);
-  cm.tri_alive.assign(nt, 1);
+  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = mesh_position(m, v);
   cm.killed_by.assign(nt, invalid_id);
   cm.alive.assign(nv, 0);
   cm.boundary.assign(nv, 0);
-  cm.head.assign(nv, detail::collapse_mesh::nil);
-  cm.next.assign(3 * nt, detail::collapse_mesh::nil);
   cm.stamp.assign(nv, 0);
   cm.last_touch.assign(nv, no_parent);
   cm.q.assign(nv, {});
   std::vector<std::uint32_t> owner(nv, invalid_id);
+  bool repeated = false;
   for (std::size_t t = nt; t-- > 0;) {
     const glm::uvec3 f = mesh_triangle(m, t);
-    cm.tri[t] = f;
     if (f.x == f.y || f.y == f.z || f.x == f.z) {
-      cm.tri_alive[t] = 0;  // a repeated index draws nothing; it never joins a corner list
+      repeated = true;  // a repeated index draws nothing; it counts for the edges below only
       continue;
     }
     for (int j = 0; j < 3; ++j) {
-      const std::uint32_t c = 3 * static_cast<std::uint32_t>(t) + static_cast<std::uint32_t>(j);
-      cm.next[c] = cm.head[f[j]];
-      cm.head[f[j]] = c;
       cm.alive[f[j]] = 1;
       owner[f[j]] = cluster[t];  // last write wins: the lowest-index triangle
     }
-    const glm::dvec3 p0 = cm.pos[f.x], p1 = cm.pos[f.y], p2 = cm.pos[f.z];
+    const glm::dvec3 p0 = cm.at(f.x), p1 = cm.at(f.y), p2 = cm.at(f.z);
     const glm::dvec3 n2 = glm::cross(p1 - p0, p2 - p0);
     const double len = glm::length(n2);
     if (!(len > 0.0)) continue;
@@ -383,24 +366,77 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       cm.q[f[j]].area += area;
     }
   }
-  // Boundary planes.
-  for (std::size_t e = 0; e < topo->edge_count(); ++e) {
-    if (!topo->is_boundary_edge(e)) continue;
-    const glm::uvec2 ab = topo->edges[e];
-    cm.boundary[ab.x] = cm.boundary[ab.y] = 1;
-    const std::uint32_t t = topo->faces_of_edge(e)[0];
-    const glm::uvec3 f = cm.tri[t];
-    const glm::dvec3 fn = glm::cross(cm.pos[f.y] - cm.pos[f.x], cm.pos[f.z] - cm.pos[f.x]);
-    const glm::dvec3 ev = cm.pos[ab.y] - cm.pos[ab.x];
-    const glm::dvec3 pn = glm::cross(ev, fn);
-    const double len = glm::length(pn);
-    if (!(len > 0.0)) continue;
-    const glm::dvec3 n = pn / len;
-    const double d = -glm::dot(n, cm.pos[ab.x]);
-    const double w = opt.boundary_weight * glm::dot(ev, ev) * (weights[3 * t] + weights[3 * t + 1] + weights[3 * t + 2]) / 3.0;
-    cm.q[ab.x].add_plane(n, d, w);
-    cm.q[ab.y].add_plane(n, d, w);
+  // Vertex → triangle adjacency, ascending triangle ids, every triangle under each distinct corner.
+  auto distinct = [](const glm::uvec3& f, int j) { return j == 0 || (f[j] != f.x && (j == 1 || f.z != f.y)); };
+  cm.first.assign(nv + 1, 0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::uvec3 f = mesh_triangle(m, t);
+    for (int j = 0; j < 3; ++j)
+      if (distinct(f, j)) ++cm.first[f[j] + 1];
   }
+  for (std::size_t v = 0; v < nv; ++v) cm.first[v + 1] += cm.first[v];
+  cm.fan.reserve(2 * std::size_t{cm.first[nv]});  // room for slices moved to the end, without reallocation copies
+  cm.fan.resize(cm.first[nv]);
+  cm.count.assign(nv, 0);
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    const glm::uvec3 f = mesh_triangle(m, t);
+    for (int j = 0; j < 3; ++j)
+      if (distinct(f, j)) cm.fan[cm.first[f[j]] + cm.count[f[j]]++] = {3 * t + static_cast<std::uint32_t>(j), f[(j + 1) % 3], f[(j + 2) % 3]};
+  }
+  // Edges (a, b), a < b, from a's triangles in ascending (a, b): more than two distinct triangles
+  // is an error; one makes a boundary edge, held by a plane through it perpendicular to its
+  // (lowest-index) triangle.
+  {
+    std::vector<std::uint32_t> hits(nv), edge_tri(nv), others, open;
+    for (std::uint32_t a = 0; a < nv; ++a) {
+      const std::uint32_t s = ++cm.stamp_now;
+      others.clear();
+      auto hit = [&](std::uint32_t b, std::uint32_t t) {
+        if (b <= a) return;
+        if (cm.stamp[b] != s) cm.stamp[b] = s, hits[b] = 0, edge_tri[b] = t, others.push_back(b);
+        ++hits[b];
+      };
+      for (const detail::fan_entry& e : cm.triangles(a)) {
+        hit(e.a, e.corner / 3);
+        if (e.b != e.a) hit(e.b, e.corner / 3);  // a triangle counts once per edge
+      }
+      std::sort(others.begin(), others.end());
+      open.clear();
+      for (std::uint32_t b : others) {
+        if (hits[b] > 2)
+          return make_error(errc::non_manifold_edge, a, "edge (", a, ", ", b, ") has ", hits[b], " triangles");
+        if (hits[b] == 1) open.push_back(b);
+      }
+      for (std::uint32_t b : open) {
+        cm.boundary[a] = cm.boundary[b] = 1;
+        const std::uint32_t t = edge_tri[b];
+        const glm::uvec3 f = mesh_triangle(m, t);
+        const glm::dvec3 fn = glm::cross(cm.at(f.y) - cm.at(f.x), cm.at(f.z) - cm.at(f.x));
+        const glm::dvec3 ev = cm.at(b) - cm.at(a);
+        const glm::dvec3 pn = glm::cross(ev, fn);
+        const double len = glm::length(pn);
+        if (!(len > 0.0)) continue;
+        const glm::dvec3 n = pn / len;
+        const double d = -glm::dot(n, cm.at(a));
+        const double w = opt.boundary_weight * glm::dot(ev, ev) * (weights[3 * t] + weights[3 * t + 1] + weights[3 * t + 2]) / 3.0;
+        cm.q[a].add_plane(n, d, w);
+        cm.q[b].add_plane(n, d, w);
+      }
+    }
+  }
+  // Triangles with a repeated index leave the slices; each slice's room is its initial length.
+  if (repeated)
+    for (std::uint32_t v = 0; v < nv; ++v) {
+      std::uint32_t kept = 0;
+      for (std::uint32_t i = 0; i < cm.count[v]; ++i) {
+        const detail::fan_entry e = cm.fan[cm.first[v] + i];
+        if (e.a != e.b && e.a != v && e.b != v) cm.fan[cm.first[v] + kept++] = e;
+      }
+      cm.count[v] = kept;
+    }
+  cm.room.assign(cm.first.begin() + 1, cm.first.end());
+  for (std::uint32_t v = 0; v < nv; ++v) cm.room[v] -= cm.first[v];
+  cm.first.pop_back();
 
   std::size_t live = 0;
   for (std::size_t v = 0; v < nv; ++v) live += cm.alive[v] ? 1 : 0;
@@ -418,10 +454,10 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   // candidates of v's neighbours (u is gone, v may be new), whose entries are updated.
   detail::vertex_heap heap;
   heap.reset(nv);
-  std::vector<std::uint32_t> candidates;
+  std::vector<std::uint32_t> candidates, joining;
   std::vector<std::pair<double, std::uint32_t>> ranked;
   std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
-  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.pos[v]); };
+  auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.at(v)); };
   // u's entry from its neighbours (ring(u)).
   auto rank = [&](std::uint32_t u, const std::vector<std::uint32_t>& ring) {
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
@@ -479,6 +515,9 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
       continue;
     }
     heap.erase(e.u);
+    joining.clear();  // the neighbours of u that v gains
+    for (std::uint32_t x : cm.ring_u)
+      if (x != e.v && cm.stamp[x] != cm.stamp_now) joining.push_back(x);
     // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
     const auto order = static_cast<std::uint32_t>(h.removed.size());
     std::uint32_t parent = no_parent;
@@ -508,14 +547,14 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
     cm.ring(e.v, cm.ring_v);
     rank(e.v, cm.ring_v);
     // A neighbour x of v: x → u vanished and x → v may be new (its cost depends on Q_x and p_v
-    // only); an entry not aiming at u stays exact unless x → v beats it. A vertex without an
-    // entry or with a fallback one is ranked anew: its refused contractions may pass now.
+    // only); an entry not aiming at u stays exact unless x joined v and x → v beats it. A vertex
+    // without an entry or with a fallback one is ranked anew: its refused contractions may pass.
     for (std::uint32_t x : cm.ring_v) {
       const detail::collapse_entry* old = heap.find(x);
       if (!old || fallback[x] || old->v == e.u) {
         set_best(x);
-      } else if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) {
-        heap.set(to_v);
+      } else if (std::find(joining.begin(), joining.end(), x) != joining.end()) {
+        if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) heap.set(to_v);
       }
     }
   }
