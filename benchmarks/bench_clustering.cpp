@@ -352,40 +352,52 @@ void BM_VisibilityChannel_Total(benchmark::State& state) {
 }
 BENCHMARK(BM_VisibilityChannel_Total)->Unit(benchmark::kMillisecond)->Iterations(2);
 
-void BM_VisibilityChannel_Exact(benchmark::State& state) {
+// Times c.prepare() on refined_elephant through 16-ray packets or Embree's coherent streams,
+// keeping every iteration's result for the checks; empty when skipped.
+std::vector<prepared_visibility_channel> time_visibility(benchmark::State& state, const visibility_channel& c, bool stream) {
   auto& e = elephant();
-  if (!e.ok) return state.SkipWithError("refined_elephant not found");
-  const support::embree_scene& stream = elephant_stream();
+  if (!e.ok) {
+    state.SkipWithError("refined_elephant not found");
+    return {};
+  }
+  const support::embree_scene& tracer = stream ? elephant_stream() : *e.tracer;
+  serial_executor exec;
+  std::vector<prepared_visibility_channel> runs;
+  for (auto _ : state) {
+    auto p = c.prepare(e.mesh, e.topo, tracer, exec);
+    if (!p) {
+      state.SkipWithError(p.error().message().c_str());
+      return {};
+    }
+    runs.push_back(std::move(*p));
+  }
+  return runs;
+}
+
+void BM_VisibilityChannel_Exact(benchmark::State& state) {
   visibility_channel c = elephant_visibility;
   c.coherent = true;
   c.cull_hull = state.range(1) != 0;
-  serial_executor exec;
-  prepared_visibility_channel p;
-  for (auto _ : state) {
-    p = std::move(*(state.range(0) != 0 ? c.prepare(e.mesh, e.topo, stream, exec) : c.prepare(e.mesh, e.topo, *e.tracer, exec)));
-    benchmark::DoNotOptimize(p);
-  }
-  if (p.visible != e.visibility.visible) state.SkipWithError("counts differ from the plain tracing");
+  const auto runs = time_visibility(state, c, state.range(0) != 0);
+  if (!runs.empty() && runs.back().visible != elephant().visibility.visible)
+    state.SkipWithError("counts differ from the plain tracing");
 }
 BENCHMARK(BM_VisibilityChannel_Exact)->Args({0, 0})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->Iterations(2);
 
 void BM_VisibilityChannel_Adaptive(benchmark::State& state) {
-  auto& e = elephant();
-  if (!e.ok) return state.SkipWithError("refined_elephant not found");
   visibility_channel c = elephant_visibility;
   c.coherent = true;
   c.adaptive_probes = static_cast<std::uint32_t>(state.range(0));
   c.adaptive_neighbours = state.range(1) != 0;
-  const support::embree_scene& stream = elephant_stream();
-  serial_executor exec;
-  prepared_visibility_channel p;
-  for (auto _ : state) {
-    p = std::move(*c.prepare(e.mesh, e.topo, stream, exec));
-    benchmark::DoNotOptimize(p);
-  }
+  const auto runs = time_visibility(state, c, true);
+  if (runs.empty()) return;
+  const prepared_visibility_channel& p = runs.back();
+  auto& e = elephant();
   visibility_channel probes_alone = c;
   probes_alone.adaptive_neighbours = false;
-  const std::vector<std::uint8_t> alone = c.adaptive_neighbours ? probes_alone.prepare(e.mesh, e.topo, stream, exec)->visible : p.visible;
+  serial_executor exec;
+  const std::vector<std::uint8_t> alone =
+      c.adaptive_neighbours ? probes_alone.prepare(e.mesh, e.topo, elephant_stream(), exec)->visible : p.visible;
   const std::vector<std::uint8_t>& exact = e.visibility.visible;
   const int bound = static_cast<int>(p.samples) - static_cast<int>(c.adaptive_probes);
   for (std::size_t i = 0; i < exact.size(); ++i) {
@@ -399,22 +411,14 @@ void BM_VisibilityChannel_Adaptive(benchmark::State& state) {
 BENCHMARK(BM_VisibilityChannel_Adaptive)->Args({1, 0})->Args({1, 1})->Args({2, 1})->Unit(benchmark::kMillisecond)->Iterations(2);
 
 void BM_VisibilityChannel_Images(benchmark::State& state) {
-  auto& e = elephant();
-  if (!e.ok) return state.SkipWithError("refined_elephant not found");
   visibility_channel c = elephant_visibility;
   c.images = true;
   c.image_resolution = static_cast<std::uint32_t>(state.range(0));
   c.image_min_pixels = static_cast<double>(state.range(1));
-  const support::embree_scene& stream = elephant_stream();
-  serial_executor exec;
-  std::vector<prepared_visibility_channel> runs;
-  for (auto _ : state) {
-    auto p = c.prepare(e.mesh, e.topo, stream, exec);
-    if (!p) return state.SkipWithError(p.error().message().c_str());
-    runs.push_back(std::move(*p));
-  }
+  const auto runs = time_visibility(state, c, true);
+  if (runs.empty()) return;
   if (runs.front().visible != runs.back().visible) return state.SkipWithError("images: counts differ between runs");
-  state.counters["mean_js"] = mean_row_js(runs.back(), e.visibility);
+  state.counters["mean_js"] = mean_row_js(runs.back(), elephant().visibility);
 }
 BENCHMARK(BM_VisibilityChannel_Images)->Args({256, 4})->Args({512, 16})->Unit(benchmark::kMillisecond)->Iterations(2);
 
