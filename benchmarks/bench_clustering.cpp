@@ -14,6 +14,14 @@
 //   BM_VisibilityChannel_Exact/S/H  the channel with coherent = true, through 16-ray packets
 //                                   (S = 0) or Embree's coherent streams (S = 1), cull_hull = H;
 //                                   counts checked equal to Total's. Goal ≤ 0.6× Total.
+//   BM_VisibilityChannel_Adaptive/P/N   adaptive_probes = P at n = 2 through coherent streams,
+//                                   neighbour rule N; checked against Total's counts by the
+//                                   documented bounds (every entry within n² − P of it; with the
+//                                   neighbour rule, equal to it or to the probe rule's entry).
+//   BM_VisibilityChannel_Images/R/M   images at resolution R, fallback under M pixels, through
+//                                   coherent streams; checked deterministic (both iterations
+//                                   give the same counts).
+//                                   Counter mean_js (both): JS of the raw p(V|t) rows against Total's.
 //                                   (Time against error of every option: infolerp_pareto visibility.)
 //   BM_Clustering_RefinedElephant_Ordered   the same on the mesh reordered for locality
 //                                   (triangles by Morton code, vertices by first use).
@@ -310,6 +318,28 @@ void BM_StretchChannel(benchmark::State& state) {
 }
 BENCHMARK(BM_StretchChannel)->Apply(direct_channel_args);
 
+const support::embree_scene& elephant_stream() {
+  static support::embree_scene stream = [] {
+    auto& e = elephant();
+    support::embree_scene s(*e.device, {.coherent_streams = true});
+    if (!s.add_mesh(e.mesh) || !s.commit()) std::abort();
+    return s;
+  }();
+  return stream;
+}
+
+// Mean JS (bits) between the raw p(V|t) rows of a and b, 1 where only one of them is unseen.
+double mean_row_js(prepared_visibility_channel a, prepared_visibility_channel b) {
+  a.denoise = b.denoise = false;
+  std::vector<std::uint32_t> all(a.visible.size() / a.viewpoints);
+  std::iota(all.begin(), all.end(), 0u);
+  const visibility_state ra = *a.init(all), rb = *b.init(all);
+  double sum = 0.0;
+  for (std::uint32_t t : all)
+    sum += ra.unseen(t) || rb.unseen(t) ? (ra.unseen(t) == rb.unseen(t) ? 0.0 : 1.0) : js_divergence(ra.row(t), rb.row(t));
+  return sum / static_cast<double>(all.size());
+}
+
 void BM_VisibilityChannel_Total(benchmark::State& state) {
   auto& e = elephant();
   if (!e.ok) return state.SkipWithError("refined_elephant not found");
@@ -322,26 +352,75 @@ void BM_VisibilityChannel_Total(benchmark::State& state) {
 }
 BENCHMARK(BM_VisibilityChannel_Total)->Unit(benchmark::kMillisecond)->Iterations(2);
 
-void BM_VisibilityChannel_Exact(benchmark::State& state) {
+// Times c.prepare() on refined_elephant through 16-ray packets or Embree's coherent streams,
+// keeping every iteration's result for the checks; empty when skipped.
+std::vector<prepared_visibility_channel> time_visibility(benchmark::State& state, const visibility_channel& c, bool stream) {
   auto& e = elephant();
-  if (!e.ok) return state.SkipWithError("refined_elephant not found");
-  static support::embree_scene stream = [&] {
-    support::embree_scene s(*e.device, {.coherent_streams = true});
-    if (!s.add_mesh(e.mesh) || !s.commit()) std::abort();
-    return s;
-  }();
+  if (!e.ok) {
+    state.SkipWithError("refined_elephant not found");
+    return {};
+  }
+  const support::embree_scene& tracer = stream ? elephant_stream() : *e.tracer;
+  serial_executor exec;
+  std::vector<prepared_visibility_channel> runs;
+  for (auto _ : state) {
+    auto p = c.prepare(e.mesh, e.topo, tracer, exec);
+    if (!p) {
+      state.SkipWithError(p.error().message().c_str());
+      return {};
+    }
+    runs.push_back(std::move(*p));
+  }
+  return runs;
+}
+
+void BM_VisibilityChannel_Exact(benchmark::State& state) {
   visibility_channel c = elephant_visibility;
   c.coherent = true;
   c.cull_hull = state.range(1) != 0;
-  serial_executor exec;
-  prepared_visibility_channel p;
-  for (auto _ : state) {
-    p = std::move(*(state.range(0) != 0 ? c.prepare(e.mesh, e.topo, stream, exec) : c.prepare(e.mesh, e.topo, *e.tracer, exec)));
-    benchmark::DoNotOptimize(p);
-  }
-  if (p.visible != e.visibility.visible) state.SkipWithError("counts differ from the plain tracing");
+  const auto runs = time_visibility(state, c, state.range(0) != 0);
+  if (!runs.empty() && runs.back().visible != elephant().visibility.visible)
+    state.SkipWithError("counts differ from the plain tracing");
 }
 BENCHMARK(BM_VisibilityChannel_Exact)->Args({0, 0})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond)->Iterations(2);
+
+void BM_VisibilityChannel_Adaptive(benchmark::State& state) {
+  visibility_channel c = elephant_visibility;
+  c.coherent = true;
+  c.adaptive_probes = static_cast<std::uint32_t>(state.range(0));
+  c.adaptive_neighbours = state.range(1) != 0;
+  const auto runs = time_visibility(state, c, true);
+  if (runs.empty()) return;
+  const prepared_visibility_channel& p = runs.back();
+  auto& e = elephant();
+  visibility_channel probes_alone = c;
+  probes_alone.adaptive_neighbours = false;
+  serial_executor exec;
+  const std::vector<std::uint8_t> alone =
+      c.adaptive_neighbours ? probes_alone.prepare(e.mesh, e.topo, elephant_stream(), exec)->visible : p.visible;
+  const std::vector<std::uint8_t>& exact = e.visibility.visible;
+  const int bound = static_cast<int>(p.samples) - static_cast<int>(c.adaptive_probes);
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    if (std::abs(int{p.visible[i]} - int{exact[i]}) > bound)
+      return state.SkipWithError("an entry is off by more than n² - P samples");
+    if (c.adaptive_neighbours && p.visible[i] != exact[i] && p.visible[i] != alone[i])
+      return state.SkipWithError("neighbour rule: an entry equals neither the exact count nor the probe rule's");
+  }
+  state.counters["mean_js"] = mean_row_js(p, e.visibility);
+}
+BENCHMARK(BM_VisibilityChannel_Adaptive)->Args({1, 0})->Args({1, 1})->Args({2, 1})->Unit(benchmark::kMillisecond)->Iterations(2);
+
+void BM_VisibilityChannel_Images(benchmark::State& state) {
+  visibility_channel c = elephant_visibility;
+  c.images = true;
+  c.image_resolution = static_cast<std::uint32_t>(state.range(0));
+  c.image_min_pixels = static_cast<double>(state.range(1));
+  const auto runs = time_visibility(state, c, true);
+  if (runs.empty()) return;
+  if (runs.front().visible != runs.back().visible) return state.SkipWithError("images: counts differ between runs");
+  state.counters["mean_js"] = mean_row_js(runs.back(), elephant().visibility);
+}
+BENCHMARK(BM_VisibilityChannel_Images)->Args({256, 4})->Args({512, 16})->Unit(benchmark::kMillisecond)->Iterations(2);
 
 // The same rays, same chunks, same tracer: only the trace_occluded calls are timed.
 void BM_VisibilityChannel_RaysOnly(benchmark::State& state) {

@@ -1,4 +1,4 @@
-// infolerp_pareto visibility --csv FILE [--reps R] [--meshes a,b,...]
+// infolerp_pareto visibility --csv FILE [--reps R] [--meshes a,b,...] [--options o,o:setting,...]
 //
 // Time against error of the visibility channel's options (cluster/visibility_channel.hpp) on
 // CGAL's meshes (default refined_elephant and armadillo), one core (serial executor, Embree
@@ -13,7 +13,7 @@
 //              alone, Th = 0.48) against the reference's clusters
 //   ari_self   the reference's clusters at Th x 1.01 against those at Th (same on every row)
 // Rows: option=default (n = 2, 64 viewpoints), option=reference (n = 4), then one row per option
-// and setting; options whose name starts with "exact" must give the default's counts bit for
+// and setting (--options keeps only the listed options, or option:setting pairs, beside those two); options whose name starts with "exact" must give the default's counts bit for
 // bit (checked here: the run fails otherwise).
 // Rows with setting "stream" trace through an Embree scene with coherent_streams
 // (rtcOccluded1M, flagged coherent) instead of 16-ray packets.
@@ -227,15 +227,16 @@ void write_plot(const std::string& csv) {
 }  // namespace
 
 int pareto_visibility(int argc, char** argv) {
-  std::string csv_path, meshes = "refined_elephant,armadillo";
+  std::string csv_path, meshes = "refined_elephant,armadillo", options;
   int reps = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--csv" && i + 1 < argc) csv_path = argv[++i];
     else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (a == "--meshes" && i + 1 < argc) meshes = argv[++i];
+    else if (a == "--options" && i + 1 < argc) options = argv[++i];
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto visibility --csv FILE [--reps R] [--meshes a,b]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto visibility --csv FILE [--reps R] [--meshes a,b] [--options o,o:s]\n");
       return 2;
     }
   }
@@ -247,7 +248,14 @@ int pareto_visibility(int argc, char** argv) {
   if (!csv) return 1;
   std::fprintf(csv, "mesh,option,setting,seconds,rays,mean_js,max_js,ari,ari_self\n");
   support::enable_flush_to_zero();
-  const std::vector<config> cfg = configs();
+  std::vector<config> cfg = configs();
+  if (!options.empty()) {
+    const std::string list = "," + options + ",";
+    std::erase_if(cfg, [&](const config& c) {
+      return c.option != "default" && c.option != "reference" && list.find("," + c.option + ",") == std::string::npos &&
+             list.find("," + c.option + ":" + c.setting + ",") == std::string::npos;
+    });
+  }
   for (std::size_t start = 0; start <= meshes.size();) {
     std::size_t end = meshes.find(',', start);
     if (end == std::string::npos) end = meshes.size();
