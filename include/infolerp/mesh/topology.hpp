@@ -14,6 +14,7 @@
 #include <vector>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 
@@ -60,7 +61,6 @@ result<mesh_topology> build_topology(const M& m) {
 
   mesh_topology topo;
   std::vector<glm::uvec3> tris(nt);
-  std::vector<std::uint32_t> start(nv + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) {
     const glm::uvec3 tri = mesh_triangle(m, t);
     for (int c = 0; c < 3; ++c)
@@ -68,27 +68,32 @@ result<mesh_topology> build_topology(const M& m) {
         return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
                           " out of range (vertex count ", nv, ")");
     tris[t] = tri;
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
-      if (a != b) ++start[std::min(a, b) + 1];
-    }
   }
-  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
 
-  // Half-edges bucketed by their smaller vertex: (larger vertex, half-edge id = 3t + c).
+  // Half-edges bucketed by their smaller vertex: (larger vertex, half-edge id = 3t + c); a
+  // half-edge (a, a) of a degenerate triangle is no edge.
   struct half_edge {
     std::uint32_t hi, id;
     bool operator<(const half_edge& o) const { return hi != o.hi ? hi < o.hi : id < o.id; }
   };
-  std::vector<half_edge> buckets(start[nv]);
-  {
-    std::vector<std::uint32_t> cursor(start.begin(), start.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t)
-      for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tris[t][c], b = tris[t][(c + 1) % 3];
-        if (a != b) buckets[cursor[std::min(a, b)]++] = {std::max(a, b), static_cast<std::uint32_t>(3 * t) + static_cast<std::uint32_t>(c)};
-      }
-  }
+  auto ends = [&](std::size_t h) {
+    const glm::uvec3& tri = tris[h / 3];
+    const int c = static_cast<int>(h % 3);
+    return glm::uvec2(tri[c], tri[(c + 1) % 3]);
+  };
+  std::vector<std::uint32_t> start;
+  std::vector<half_edge> buckets;
+  detail::group_by_key(
+      nv, 3 * nt,
+      [&](std::size_t h) {
+        const auto e = ends(h);
+        return e.x == e.y ? detail::no_bucket : std::min(e.x, e.y);
+      },
+      [&](std::size_t h) {
+        const auto e = ends(h);
+        return half_edge{std::max(e.x, e.y), static_cast<std::uint32_t>(h)};
+      },
+      start, buckets);
 
   topo.triangle_edges.assign(3 * nt, invalid_id);
   topo.edge_faces.reserve(buckets.size());
