@@ -26,7 +26,7 @@ static void BM_Subdivision_Uniform(benchmark::State& state) {
   std::vector<std::uint32_t> leaves;
   for (auto _ : state) {
     state.PauseTiming();
-    auto s = infolerp::subdivision_mesh::build(*m);
+    auto s = infolerp::subdivision_mesh::create(*m);
     state.ResumeTiming();
     for (int level = 0; level < 3; ++level) {
       leaves.clear();
@@ -47,7 +47,7 @@ static void BM_Subdivision_RandomSelections(benchmark::State& state) {
   std::vector<std::uint32_t> picks;
   for (auto _ : state) {
     state.PauseTiming();
-    auto s = infolerp::subdivision_mesh::build(*m);
+    auto s = infolerp::subdivision_mesh::create(*m);
     std::mt19937 rng(1);
     state.ResumeTiming();
     for (int i = 0; i < 20000; ++i) {

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir, ec);
   auto scene = sup::make_walkthrough_scene();
   if (!scene) return std::fprintf(stderr, "refine_wireframe: %s\n", scene.error().message().c_str()), 1;
-  auto sub = infolerp::subdivision_mesh::build(scene->mesh);
+  auto sub = infolerp::subdivision_mesh::create(scene->mesh);
   if (!sub) return std::fprintf(stderr, "refine_wireframe: %s\n", sub.error().message().c_str()), 1;
   infolerp::driver_options o;
   o.criteria.criterion = infolerp::refinement_criterion::nld_os;

@@ -29,7 +29,7 @@ namespace {
 constexpr std::uint32_t width = 240, height = 180;
 
 infolerp::progressive_refiner make_agent(const sup::walkthrough_scene& sc) {
-  auto sub = infolerp::subdivision_mesh::build(sc.mesh);
+  auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   if (!sub) std::fprintf(stderr, "walkthrough: %s\n", sub.error().message().c_str()), std::exit(1);
   auto r = infolerp::progressive_refiner::create(std::move(*sub), {.criteria = {.s_req = 0.05f}});
   if (!r) std::fprintf(stderr, "walkthrough: %s\n", r.error().message().c_str()), std::exit(1);
@@ -106,13 +106,13 @@ int main(int argc, char** argv) {
     const std::size_t before = agent.samples_delivered();
     for (bool more = true; more;) {
       shade_on_threads(agent, sc, 4, shown);
-      more = agent.refine(exec) == infolerp::refine_progress::refined;
+      more = agent.refine({}, exec) == infolerp::refine_progress::refined;
       follow(agent, shown);
     }
     // The synchronous single-threaded walk of the same path.
     if (auto st = sync.set_view(sc, cam, exec); !st) return 1;
     sync.shade_requests(shade, exec);
-    while (sync.refine(shade, exec) == infolerp::refine_progress::refined) {
+    while (sync.refine(shade, {}, exec) == infolerp::refine_progress::refined) {
     }
     std::vector<glm::vec3> a(std::size_t(width) * height), b(a.size());
     agent.reconstruct(a);

@@ -33,7 +33,7 @@ struct shaded {
 static_assert(std::is_trivially_copyable_v<infolerp::shading_point> && std::is_trivially_copyable_v<shaded>);
 
 infolerp::progressive_refiner make_agent(const sup::walkthrough_scene& sc) {
-  auto sub = infolerp::subdivision_mesh::build(sc.mesh);
+  auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   if (!sub) std::fprintf(stderr, "walkthrough_mpi: %s\n", sub.error().message().c_str()), std::exit(1);
   auto r = infolerp::progressive_refiner::create(std::move(*sub), {.criteria = {.s_req = 0.05f}});
   if (!r) std::fprintf(stderr, "walkthrough_mpi: %s\n", r.error().message().c_str()), std::exit(1);
@@ -119,9 +119,9 @@ int main(int argc, char** argv) {
     if (!agent.set_view(*scene, cam, exec).ok() || !local.set_view(*scene, cam, exec).ok()) return MPI_Abort(MPI_COMM_WORLD, 1), 1;
     const std::size_t before = agent.samples_delivered();
     do shade_remotely(agent, ranks);
-    while (agent.refine(exec) == infolerp::refine_progress::refined);
+    while (agent.refine({}, exec) == infolerp::refine_progress::refined);
     local.shade_requests(shade, exec);
-    while (local.refine(shade, exec) == infolerp::refine_progress::refined) {
+    while (local.refine(shade, {}, exec) == infolerp::refine_progress::refined) {
     }
     std::vector<glm::vec3> a(std::size_t(width) * height), b(a.size());
     agent.reconstruct(a);

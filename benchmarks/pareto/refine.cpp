@@ -59,7 +59,7 @@ template <class E>
 run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::vector<glm::vec3>& reference,
                infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec,
                float rnd_fraction = 1.0f, float random_share = 0.0f) {
-  auto sub = infolerp::subdivision_mesh::build(sc.mesh);
+  auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   if (!sub.ok()) {
     std::fprintf(stderr, "%s\n", sub.error().message().c_str());
     std::exit(1);

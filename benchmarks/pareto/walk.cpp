@@ -50,7 +50,7 @@ std::vector<glm::vec3> reference_image(const scene& sc, const infolerp::pinhole_
 }
 
 infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_criterion c) {
-  auto sub = infolerp::subdivision_mesh::build(sc.mesh);
+  auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   infolerp::driver_options o;
   o.criteria.criterion = c;
   o.criteria.batch = 64;
@@ -109,7 +109,7 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
       std::exit(1);
     }
     agent.take_delta(delta);
-    const infolerp::refine_progress p = agent.refine(ex);
+    const infolerp::refine_progress p = agent.refine({}, ex);
     batch_agent += seconds_since(t);
     row.agent += batch_agent;
     row.shader += shader;

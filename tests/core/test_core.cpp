@@ -1,12 +1,14 @@
-// core/: status and result, mesh traits and concepts, tracer and executor concepts.
+// core/: status and result, the CSR counting sort, mesh traits and concepts, tracer and executor concepts.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
 #include <numeric>
 #include <vector>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/large_buffer.hpp"
 #include "infolerp/core/mesh_traits.hpp"
@@ -187,4 +189,38 @@ TEST_CASE("large_buffer_allocator: 2 MiB aligned from 4 MiB, values kept through
   buffer moved = std::move(small);
   CHECK(moved.size() == 1000);
   CHECK(moved[500] == 500.0f);
+}
+
+TEST_CASE("group_by_key: stable CSR buckets, empty buckets, skipped items, reused buffers") {
+  using infolerp::detail::group_by_key, infolerp::detail::no_bucket;
+  std::vector<std::uint32_t> offsets, grouped;
+  // Items 0..6 with keys {2, 0, 2, skip, 0, 2, 4} over 5 buckets; the value of item i is 10 * i.
+  const std::vector<std::uint32_t> keys{2, 0, 2, no_bucket, 0, 2, 4};
+  group_by_key(
+      5, keys.size(), [&](std::size_t i) { return keys[i]; }, [](std::size_t i) { return static_cast<std::uint32_t>(10 * i); },
+      offsets, grouped);
+  CHECK(offsets == std::vector<std::uint32_t>{0, 2, 2, 5, 5, 6});
+  CHECK(grouped == std::vector<std::uint32_t>{10, 40, 0, 20, 50, 60});
+
+  // Reused buffers with fewer buckets and more items: same as a stable sort by key.
+  std::vector<std::uint32_t> many(1000);
+  for (std::size_t i = 0; i < many.size(); ++i) many[i] = static_cast<std::uint32_t>((i * 7919u) % 3u);
+  group_by_key(
+      3, many.size(), [&](std::size_t i) { return many[i]; }, [](std::size_t i) { return static_cast<std::uint32_t>(i); },
+      offsets, grouped);
+  std::vector<std::uint32_t> expected(many.size());
+  std::iota(expected.begin(), expected.end(), 0u);
+  std::stable_sort(expected.begin(), expected.end(), [&](std::uint32_t a, std::uint32_t b) { return many[a] < many[b]; });
+  CHECK(grouped == expected);
+  REQUIRE(offsets.size() == 4);
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    CHECK(offsets[k + 1] - offsets[k] == static_cast<std::uint32_t>(std::count(many.begin(), many.end(), k)));
+    for (std::uint32_t j = offsets[k]; j < offsets[k + 1]; ++j) CHECK(many[grouped[j]] == k);
+  }
+
+  // No items: every bucket empty.
+  group_by_key(
+      3, 0, [](std::size_t) { return 0u; }, [](std::size_t) { return 0u; }, offsets, grouped);
+  CHECK(offsets == std::vector<std::uint32_t>{0, 0, 0, 0});
+  CHECK(grouped.empty());
 }

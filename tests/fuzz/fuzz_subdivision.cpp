@@ -56,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   opt.bisect_ratio = static_cast<float>(r.unit() * 2.0);
   opt.propagation_depth = r.u8() % 5;
   const infolerp::indexed_mesh m = (flags & 1) ? grid(1 + (flags >> 1) % 4) : fuzz::read_mesh(r, 24, 32);
-  auto built = infolerp::subdivision_mesh::build(m, opt);
+  auto built = infolerp::subdivision_mesh::create(m, opt);
   fuzz::check_error(built.error());
   if (!built.ok()) return 0;
   infolerp::subdivision_mesh& s = *built;

@@ -27,7 +27,7 @@ TEST_CASE("leaf_mesh keeps texcoords, normals and keyframes, and names each leaf
   m.keyframes.push_back(m.positions);
   m.keyframes.emplace_back();
   for (const auto& p : m.positions) m.keyframes[1].push_back(keyframe1(p));
-  auto s = infolerp::subdivision_mesh::build(m);
+  auto s = infolerp::subdivision_mesh::create(m);
   REQUIRE(s);
   REQUIRE(s->split(0));
   REQUIRE(s->split(7));

@@ -52,7 +52,7 @@ std::vector<glm::vec3> reference(const indexed_mesh& m, const pinhole_camera& ca
 }
 
 progressive_refiner make_refiner(const indexed_mesh& m, driver_options o, subdivision_options so = {}) {
-  auto s = subdivision_mesh::build(m, so);
+  auto s = subdivision_mesh::create(m, so);
   REQUIRE(s.ok());
   auto r = progressive_refiner::create(std::move(*s), o);
   REQUIRE(r.ok());
@@ -84,6 +84,33 @@ TEST_CASE("driver: stage 1 shades each visible original vertex once") {
   CHECK(calls == 4);
   CHECK(rep->batches == 0);
   CHECK(rep->budget_reached);
+}
+
+TEST_CASE("driver: every defaulted executor argument is serial_executor") {
+  const auto m = floor_mesh();
+  const brute_force_tracer tracer{&m};
+  auto shade = [](const shading_point& sp) { return shadowed(sp.position); };
+  const driver_options o{.criteria = {.criterion = refinement_criterion::nld_os, .s_req = 0.05f, .batch = 8}};
+  auto a = make_refiner(m, o), b = make_refiner(m, o);
+  // start() keeps its executor: start(tracer, camera, x) would not say whether x shades or runs.
+  REQUIRE(a.start(tracer, top_camera(32, 24), shade, serial_executor{}).ok());
+  REQUIRE(b.start(tracer, top_camera(32, 24), shade, serial_executor{}).ok());
+  CHECK(a.refine(shade, {.batches = 2}, serial_executor{}) == b.refine(shade, {.batches = 2}));
+  CHECK(a.refine_batch(shade, serial_executor{}) == b.refine_batch(shade));
+  REQUIRE(a.set_view(tracer, top_camera(24, 32), serial_executor{}).ok());
+  REQUIRE(b.set_view(tracer, top_camera(24, 32)).ok());
+  CHECK(a.refine({}, serial_executor{}) == b.refine());
+  CHECK(a.report().selections > 0);
+  CHECK(a.report().selections == b.report().selections);
+  CHECK(image_of(a, top_camera(24, 32)) == image_of(b, top_camera(24, 32)));
+  auto c = make_refiner(m, o), d = make_refiner(m, o);
+  const auto rc = c.run(tracer, top_camera(), shade, serial_executor{});
+  const auto rd = d.run(tracer, top_camera(), shade);
+  REQUIRE(rc.ok());
+  REQUIRE(rd.ok());
+  CHECK(rc->batches == rd->batches);
+  CHECK(rc->stage2.shading_samples == rd->stage2.shading_samples);
+  CHECK(image_of(c, top_camera()) == image_of(d, top_camera()));
 }
 
 TEST_CASE("driver: affine shading is reproduced exactly at every refinement level") {
@@ -247,7 +274,7 @@ TEST_CASE("driver: NLD_OS with a random pass finds a shadow that no vertex shows
 
 TEST_CASE("driver: errors") {
   const auto m = floor_mesh();
-  auto s = subdivision_mesh::build(m);
+  auto s = subdivision_mesh::create(m);
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(*s, {.criteria = {.s_req = 2.0f}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.batch = 0}}).error().code() == errc::bad_parameter);

@@ -204,7 +204,7 @@ TEST_CASE("subdivision: two triangles of a square, by hand") {
   sq.triangles = {{0, 1, 2}, {0, 2, 3}};  // shared diagonal (0,2): ratio 2·area/width² = 0.5 for both
 
   SECTION("flat neighbour: 1:2 closure") {
-    auto s = subdivision_mesh::build(sq, {.bisect_ratio = 0.6f});
+    auto s = subdivision_mesh::create(sq, {.bisect_ratio = 0.6f});
     REQUIRE(s.ok());
     REQUIRE(s->split(0u).ok());
     CHECK(s->triangle_count() == 2 + 4 + 2);
@@ -231,7 +231,7 @@ TEST_CASE("subdivision: two triangles of a square, by hand") {
     CHECK(s->triangle_count() == 12);
   }
   SECTION("well-shaped neighbour: 1:4 propagation") {
-    auto s = subdivision_mesh::build(sq, {.bisect_ratio = 0.5f});
+    auto s = subdivision_mesh::create(sq, {.bisect_ratio = 0.5f});
     REQUIRE(s.ok());
     REQUIRE(s->split(0u).ok());
     CHECK(s->leaf_count() == 8);
@@ -240,7 +240,7 @@ TEST_CASE("subdivision: two triangles of a square, by hand") {
     check_invariants(*s, sq);
   }
   SECTION("deeper split on one side closes the other side") {
-    auto s = subdivision_mesh::build(sq, {.bisect_ratio = 0.6f});
+    auto s = subdivision_mesh::create(sq, {.bisect_ratio = 0.6f});
     REQUIRE(s.ok());
     REQUIRE(s->split(0u).ok());
     // child 0 of triangle 0 = (v0, m0, m2) has edge (m2, v0) on the diagonal.
@@ -249,25 +249,25 @@ TEST_CASE("subdivision: two triangles of a square, by hand") {
     CHECK(s->triangle(1).child_count == 4);  // the 1:2 neighbour had to become 1:4
   }
   SECTION("errors name the element") {
-    auto s = subdivision_mesh::build(sq);
+    auto s = subdivision_mesh::create(sq);
     REQUIRE(s.ok());
     const auto st = s->split(99u);
     CHECK(st.code() == infolerp::errc::index_out_of_range);
     CHECK(st.element() == 99);
     indexed_mesh bad = sq;
     bad.triangles.push_back({1, 1, 2});
-    CHECK(subdivision_mesh::build(bad).error().element() == 2);
+    CHECK(subdivision_mesh::create(bad).error().element() == 2);
     bad.triangles.back() = {0, 1, 7};
-    CHECK(subdivision_mesh::build(bad).error().code() == infolerp::errc::index_out_of_range);
+    CHECK(subdivision_mesh::create(bad).error().code() == infolerp::errc::index_out_of_range);
     bad.triangles.back() = {0, 1, 2};
     bad.triangles.push_back({0, 1, 2});
-    CHECK(subdivision_mesh::build(bad).error().code() == infolerp::errc::non_manifold_edge);
+    CHECK(subdivision_mesh::create(bad).error().code() == infolerp::errc::non_manifold_edge);
     indexed_mesh flat = sq;
     flat.positions[2] = {0.5f, 0.5f, 0.0f};  // triangle 0 = (0,0) (1,0) (.5,.5) ok; make 1 collinear
     flat.positions[3] = {1.0f, 1.0f, 0.0f};
-    CHECK(subdivision_mesh::build(flat).error().code() == infolerp::errc::degenerate_triangle);
-    CHECK(subdivision_mesh::build(indexed_mesh{}).error().code() == infolerp::errc::empty_input);
-    CHECK(subdivision_mesh::build(sq, {.bisect_ratio = -1.0f}).error().code() == infolerp::errc::bad_parameter);
+    CHECK(subdivision_mesh::create(flat).error().code() == infolerp::errc::degenerate_triangle);
+    CHECK(subdivision_mesh::create(indexed_mesh{}).error().code() == infolerp::errc::empty_input);
+    CHECK(subdivision_mesh::create(sq, {.bisect_ratio = -1.0f}).error().code() == infolerp::errc::bad_parameter);
   }
 }
 
@@ -277,7 +277,7 @@ TEST_CASE("subdivision: midpoints of coordinates near FLT_MAX stay finite") {
   indexed_mesh m;
   m.positions = {{big, big, 0}, {big, -big, 0}, {big, big, big}};
   m.triangles = {{0, 1, 2}};
-  auto s = subdivision_mesh::build(m, {});
+  auto s = subdivision_mesh::create(m, {});
   REQUIRE(s.ok());
   REQUIRE(s->split(0u).ok());
   REQUIRE(s->vertex_count() == 6);
@@ -293,7 +293,7 @@ TEST_CASE("subdivision: thousands of random selections on fandisk keep every inv
   auto mesh = infolerp::support::load_mesh(infolerp::support::cgal_mesh("fandisk"));
   REQUIRE(mesh.ok());
   for (std::uint32_t depth : {0u, 1u, 2u}) {
-    auto s = subdivision_mesh::build(*mesh, {.bisect_ratio = 0.5f, .propagation_depth = depth});
+    auto s = subdivision_mesh::create(*mesh, {.bisect_ratio = 0.5f, .propagation_depth = depth});
     REQUIRE(s.ok());
     random_selections(*s, *mesh, 2000, 11 + depth, 1000);
     INFO("depth " << depth << ": " << s->leaf_count() << " leaves");
@@ -304,14 +304,14 @@ TEST_CASE("subdivision: thousands of random selections on fandisk keep every inv
 TEST_CASE("subdivision: random selections on bunny00 (open mesh with boundaries)") {
   auto mesh = infolerp::support::load_mesh(infolerp::support::cgal_mesh("bunny00"));
   REQUIRE(mesh.ok());
-  auto s = subdivision_mesh::build(*mesh, {.bisect_ratio = 0.8f, .propagation_depth = 1});
+  auto s = subdivision_mesh::create(*mesh, {.bisect_ratio = 0.8f, .propagation_depth = 1});
   REQUIRE(s.ok());
   random_selections(*s, *mesh, 3000, 5, 1500);
 }
 
 TEST_CASE("subdivision: unbounded propagation and repeated deep selections on a small sphere") {
   const auto sphere = infolerp::support::make_icosphere(1);
-  auto s = subdivision_mesh::build(sphere, {.bisect_ratio = 0.9f, .propagation_depth = 1000});
+  auto s = subdivision_mesh::create(sphere, {.bisect_ratio = 0.9f, .propagation_depth = 1000});
   REQUIRE(s.ok());
   random_selections(*s, sphere, 120, 3, 40);
   // Drill into one spot: select the leaf under a fixed point again and again; its level grows
@@ -328,7 +328,7 @@ TEST_CASE("subdivision: unbounded propagation and repeated deep selections on a 
 TEST_CASE("subdivision: point location matches brute force and follows splits") {
   auto mesh = infolerp::support::load_mesh(infolerp::support::cgal_mesh("fandisk"));
   REQUIRE(mesh.ok());
-  auto s = subdivision_mesh::build(*mesh);
+  auto s = subdivision_mesh::create(*mesh);
   REQUIRE(s.ok());
   std::mt19937 rng(99);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
@@ -385,7 +385,7 @@ TEST_CASE("subdivision: point location matches brute force and follows splits") 
 
 TEST_CASE("subdivision: §4.1 tessellation to a screen fraction") {
   const auto plane = infolerp::support::make_plane(1, 1, 2.0f);  // covers NDC [-1,1]² under identity
-  auto s = subdivision_mesh::build(plane);
+  auto s = subdivision_mesh::create(plane);
   REQUIRE(s.ok());
   // Each half covers 1/2 of the screen; 1/2 · 4^-k <= 0.01 first at k = 3.
   s->tessellate(infolerp::screen_fraction_test{.view_projection = glm::mat4(1.0f), .max_fraction = 0.01f});
@@ -394,7 +394,7 @@ TEST_CASE("subdivision: §4.1 tessellation to a screen fraction") {
     if (n.is_leaf()) CHECK(n.level == 3);
   check_invariants(*s, plane);
   // max_level bounds it.
-  auto capped = subdivision_mesh::build(plane);
+  auto capped = subdivision_mesh::create(plane);
   REQUIRE(capped.ok());
   capped->tessellate(infolerp::screen_fraction_test{.max_fraction = 1e-9f}, 2);
   CHECK(capped->leaf_count() == 2 * 16);
@@ -467,7 +467,7 @@ TEST_CASE("subdivision: tessellation never splits triangles behind the eye or ou
   const auto plane = infolerp::support::make_plane(4, 4, 64.0f);
   indexed_mesh ground;
   infolerp::support::append(ground, plane, glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(1, 0, 0)));
-  auto s = subdivision_mesh::build(ground);
+  auto s = subdivision_mesh::create(ground);
   REQUIRE(s.ok());
   const glm::vec3 eye{0.0f, 1.0f, 0.0f};
   const glm::mat4 view = glm::lookAt(eye, glm::vec3(0.0f, 0.8f, -5.0f), glm::vec3(0.0f, 1.0f, 0.0f));
@@ -503,7 +503,7 @@ TEST_CASE("subdivision: tessellation leaves a mesh behind the eye or beside the 
                              glm::vec3(0.0f, -40.0f, -5.0f)};  // far below
   for (const glm::vec3 look : looks) {
     INFO("looking along " << look.x << " " << look.y << " " << look.z);
-    auto s = subdivision_mesh::build(plane);
+    auto s = subdivision_mesh::create(plane);
     REQUIRE(s.ok());
     const glm::mat4 view = glm::lookAt(glm::vec3(0.0f, 0.0f, 5.0f), glm::vec3(0.0f, 0.0f, 5.0f) + look, glm::vec3(0, 1, 0));
     CHECK(s->tessellate(infolerp::screen_fraction_test{.view_projection = projection * view, .max_fraction = 1e-6f}) == 0);

@@ -28,7 +28,7 @@ const support::walkthrough_scene& scene() {
 }
 
 progressive_refiner make_agent(driver_options o = {}) {
-  auto s = subdivision_mesh::build(scene().mesh);
+  auto s = subdivision_mesh::create(scene().mesh);
   REQUIRE(s.ok());
   o.criteria.min_pixels = 6.0f;
   auto r = progressive_refiner::create(std::move(*s), o);
@@ -63,7 +63,7 @@ walk_record walk_sync(progressive_refiner& r, E&& exec) {
   for (std::uint32_t f = 0; f < FRAMES; ++f) {
     REQUIRE(r.set_view(scene(), support::walkthrough_path(f, FRAMES, W, H), exec).ok());
     r.shade_requests(shader(), exec);
-    while (r.refine(shader(), exec, {.batches = 4}) == refine_progress::refined) {
+    while (r.refine(shader(), {.batches = 4}, exec) == refine_progress::refined) {
     }
     out.images.push_back(image_of(r));
     out.samples.push_back(r.samples_delivered());
@@ -123,7 +123,7 @@ TEST_CASE("walkthrough: asynchronous delivery in any order, the delta replay and
           apply_delta();
         });
       for (auto& w : workers) w.join();
-      if (r.refine(pool) != refine_progress::refined) break;
+      if (r.refine({}, pool) != refine_progress::refined) break;
       apply_delta();
     }
     REQUIRE(r.outstanding_requests() == 0);
@@ -154,7 +154,7 @@ TEST_CASE("walkthrough: revisiting a view shades nothing new") {
   // The same view again: no request, nothing to refine, the same image.
   REQUIRE(r.set_view(scene(), street, ex).ok());
   CHECK(r.outstanding_requests() == 0);
-  CHECK(r.refine(shader(), ex) == refine_progress::finished);
+  CHECK(r.refine(shader(), {}, ex) == refine_progress::finished);
   CHECK(r.samples_delivered() == after_first);
   // Same colours; pixel weights are located afresh from the root (not followed batch by batch),
   // so they may differ in the last float bits.
@@ -166,12 +166,12 @@ TEST_CASE("walkthrough: revisiting a view shades nothing new") {
   // leaves can be finer now; the few corners no view shaded yet are all that is asked for.
   REQUIRE(r.set_view(scene(), temple, ex).ok());
   r.shade_requests(shader(), ex);
-  while (r.refine(shader(), ex, {.batches = 8}) == refine_progress::refined) {
+  while (r.refine(shader(), {.batches = 8}, ex) == refine_progress::refined) {
   }
   const std::size_t after_temple = r.samples_delivered();
   REQUIRE(r.set_view(scene(), street, ex).ok());
   r.shade_requests(shader(), ex);
-  while (r.refine(shader(), ex, {.batches = 8}) == refine_progress::refined) {
+  while (r.refine(shader(), {.batches = 8}, ex) == refine_progress::refined) {
   }
   INFO("street " << after_first << ", temple +" << after_temple - after_first << ", street again +"
                  << r.samples_delivered() - after_temple);
@@ -187,7 +187,7 @@ TEST_CASE("walkthrough: only visible triangles are selected, and a view change i
     REQUIRE(r.set_view(scene(), cam, ex).ok());
     r.shade_requests(shader(), ex);
     // Two batches per frame at most (an engine calling once per frame), then the view moves on.
-    for (int b = 0; b < 2 && r.refine(shader(), ex) == refine_progress::refined; ++b) {
+    for (int b = 0; b < 2 && r.refine(shader(), {}, ex) == refine_progress::refined; ++b) {
       ++batches;
       const glm::vec3 fwd = glm::normalize(cam.target - cam.eye);
       for (std::uint32_t t : r.last_selection()) {
@@ -204,15 +204,15 @@ TEST_CASE("walkthrough: only visible triangles are selected, and a view change i
   // Budgets: a zero time budget or a one-sample budget still runs exactly one batch.
   auto a = make_agent({.criteria = {.batch = 2}});
   REQUIRE(a.start(scene(), support::walkthrough_camera(W, H), shader(), ex).ok());
-  CHECK(a.refine(shader(), ex, {.batches = 1000, .seconds = 0.0}) == refine_progress::refined);
+  CHECK(a.refine(shader(), {.batches = 1000, .seconds = 0.0}, ex) == refine_progress::refined);
   CHECK(a.report().batches == 1);
-  CHECK(a.refine(shader(), ex, {.batches = 1000, .samples = 1}) == refine_progress::refined);
+  CHECK(a.refine(shader(), {.batches = 1000, .samples = 1}, ex) == refine_progress::refined);
   CHECK(a.report().batches == 2);
   // Without a renderer the second batch waits for the first one's deliveries.
-  CHECK(a.refine(ex, {.batches = 5}) == refine_progress::refined);
+  CHECK(a.refine({.batches = 5}, ex) == refine_progress::refined);
   CHECK(a.report().batches == 3);
   CHECK(a.outstanding_requests() > 0);
-  CHECK(a.refine(ex) == refine_progress::waiting);
+  CHECK(a.refine({}, ex) == refine_progress::waiting);
 }
 
 TEST_CASE("walkthrough: start() after a finished run is a full restart") {
@@ -254,7 +254,7 @@ TEST_CASE("walkthrough: the cache bound is honoured and changes no image") {
     r.shade_requests(shader(), ex);
     CHECK(r.cached_samples() <= bound);
     refine_progress p;
-    while ((p = r.refine(shader(), ex)) == refine_progress::refined) CHECK(r.cached_samples() <= bound);
+    while ((p = r.refine(shader(), {}, ex)) == refine_progress::refined) CHECK(r.cached_samples() <= bound);
     CHECK(p == refine_progress::finished);  // the bound never stopped refinement here
     INFO("frame " << f);
     CHECK(same_bits(image_of(r), reference.images[f]));
@@ -267,7 +267,7 @@ TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
   auto r = make_agent();
   const pinhole_camera street = support::walkthrough_camera(W, H);
   REQUIRE(r.start(scene(), street, shader(), ex).ok());
-  REQUIRE(r.refine(ex) == refine_progress::refined);  // leaves requests outstanding
+  REQUIRE(r.refine({}, ex) == refine_progress::refined);  // leaves requests outstanding
   std::vector<shading_point> req;
   r.take_requests(req, 3);
   REQUIRE(req.size() == 3);
@@ -325,7 +325,7 @@ TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
   CHECK(r.outstanding_requests() == outstanding - 1);
   // A cache bound of zero.
   CHECK(r.set_cache_bound(0).code() == errc::bad_parameter);
-  auto s = subdivision_mesh::build(scene().mesh);
+  auto s = subdivision_mesh::create(scene().mesh);
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(std::move(*s), {.max_cached_samples = 0}).error().code() == errc::bad_parameter);
 }
@@ -340,7 +340,7 @@ TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS s
     const auto before = image_of(r);
     float l_max = 0.0f;
     for (const glm::vec3& c : before) l_max = std::max(l_max, luminance(c));
-    REQUIRE(r.refine(ex) == refine_progress::refined);  // L_max taken from `before`, then the split
+    REQUIRE(r.refine({}, ex) == refine_progress::refined);  // L_max taken from `before`, then the split
     CHECK(r.frame().l_max == l_max);
     r.shade_requests(shader(), ex);
   }
@@ -357,7 +357,7 @@ TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS s
   CHECK(double(b->stage2.shading_samples) >= cap);
   CHECK(double(b->stage2.shading_samples) <= cap + 4 * 12);  // one batch of R = 4 may overshoot (<= 12 vertices each)
   CHECK(!b->budget_reached);  // the criterion's own rule ended it
-  auto bad = subdivision_mesh::build(scene().mesh);
+  auto bad = subdivision_mesh::create(scene().mesh);
   REQUIRE(bad.ok());
   CHECK(progressive_refiner::create(std::move(*bad), {.criteria = {.nld_is_pixel_fraction = -1.0f}}).error().code() ==
         errc::bad_parameter);

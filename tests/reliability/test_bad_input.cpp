@@ -109,7 +109,7 @@ enum mesh_entry : std::size_t {
 };
 const char* const mesh_entry_names[mesh_entry_count] = {
     "validate_mesh", "build_topology", "mean_curvature", "compute_saliency",
-    "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::build",
+    "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::create",
     "cluster_mesh(visibility+orientation+stretch)"};
 
 struct mesh_class {
@@ -290,7 +290,7 @@ std::pair<status, bool> run_mesh_entry(mesh_entry e, const indexed_mesh& m) {
       return {status_of(r), good};
     }
     case e_subdivision_build: {
-      auto r = infolerp::subdivision_mesh::build(m);
+      auto r = infolerp::subdivision_mesh::create(m);
       return {status_of(r), !r.ok() || r->leaf_count() == nt};
     }
     case mesh_entry_count: break;
@@ -319,7 +319,7 @@ struct fixed_tracer {
 // Starts a fresh refiner with a tracer; checks that a failed start leaves it unchanged.
 std::pair<status, bool> start_with(const infolerp::hit& h, std::uint32_t w = 8, std::uint32_t hgt = 8) {
   const indexed_mesh m = floor_mesh();
-  auto r = infolerp::progressive_refiner::create(*infolerp::subdivision_mesh::build(m));
+  auto r = infolerp::progressive_refiner::create(*infolerp::subdivision_mesh::create(m));
   REQUIRE(r.ok());
   const status st = r->start(fixed_tracer{h}, top_camera(w, hgt), grey, infolerp::serial_executor{});
   const bool untouched = st.ok() || (r->pixel_leaves().empty() && r->visible_leaves().empty() &&
@@ -561,12 +561,14 @@ TEST_CASE("bad-input matrix: clustering options and channels", "[reliability][ba
 
 TEST_CASE("bad-input matrix: refinement (subdivision, criteria, driver, tracers)", "[reliability][bad_input]") {
   const indexed_mesh m = floor_mesh();
-  check_cell("threshold below 0", "subdivision_mesh::build",
-             status_of(infolerp::subdivision_mesh::build(m, {.bisect_ratio = -0.5f})), {errc::bad_parameter, "bisect_ratio"});
-  check_cell("threshold NaN", "subdivision_mesh::build",
-             status_of(infolerp::subdivision_mesh::build(m, {.bisect_ratio = nan_f})), {errc::bad_parameter, "bisect_ratio"});
+  check_cell("threshold below 0", "subdivision_mesh::create",
+             status_of(infolerp::subdivision_mesh::create(m, {.bisect_ratio = -0.5f})),
+             {errc::bad_parameter, "bisect_ratio"});
+  check_cell("threshold NaN", "subdivision_mesh::create",
+             status_of(infolerp::subdivision_mesh::create(m, {.bisect_ratio = nan_f})),
+             {errc::bad_parameter, "bisect_ratio"});
   {
-    auto s = infolerp::subdivision_mesh::build(m);
+    auto s = infolerp::subdivision_mesh::create(m);
     REQUIRE(s.ok());
     check_cell("index out of range", "subdivision_mesh::split(t)", s->split(99u), {errc::index_out_of_range, "triangle 99"});
     // A selection with a bad id in the middle: nothing is split.
@@ -587,7 +589,7 @@ TEST_CASE("bad-input matrix: refinement (subdivision, criteria, driver, tracers)
   check_cell("threshold exactly 0 and 1 (valid)", "validate(criteria_options)", crit({.s_req = 0.0f}), ok);
   check_cell("threshold exactly 0 and 1 (valid)", "validate(criteria_options)", crit({.s_req = 1.0f}), ok);
   {
-    auto s = infolerp::subdivision_mesh::build(m);
+    auto s = infolerp::subdivision_mesh::create(m);
     check_cell("threshold NaN", "progressive_refiner::create",
                status_of(infolerp::progressive_refiner::create(*s, {.criteria = {.s_req = nan_f}})), {errc::bad_parameter, "s_req"});
     check_cell("zero count", "progressive_refiner::create",
@@ -671,7 +673,7 @@ TEST_CASE("bad-input matrix: upsampler and pass controller", "[reliability][bad_
   {
     std::vector<glm::vec3> none;
     check_cell("image size 0x0", "upsample(one-shot)",
-               infolerp::upsample(src, 0, 0, std::span<glm::vec3>(none), infolerp::serial_executor{}),
+               infolerp::upsample(src, 0, 0, std::span<glm::vec3>(none)),
                {errc::empty_input, "0x0"});
   }
   {  // fuzzed-looking cluster ids (background, huge ids) are valid data: every pixel written, finite

@@ -142,7 +142,7 @@ TEST_CASE("determinism: subdivision and the progressive driver for 1, 2, 8 worke
   const indexed_mesh m = infolerp::support::make_plane(3, 2, 2.0f);
   {  // the subdivision mesh alone, same selections twice
     auto run = [&] {
-      auto s = infolerp::subdivision_mesh::build(m);
+      auto s = infolerp::subdivision_mesh::create(m);
       REQUIRE(s.ok());
       std::uint32_t t = 0;
       for (int i = 0; i < 40; ++i) {
@@ -169,7 +169,7 @@ TEST_CASE("determinism: subdivision and the progressive driver for 1, 2, 8 worke
     };
     const auto outs = with_every_executor([&](auto exec) {
       auto r = infolerp::progressive_refiner::create(
-          *infolerp::subdivision_mesh::build(m),
+          *infolerp::subdivision_mesh::create(m),
           {.criteria = {.criterion = criterion, .s_req = 0.02f, .min_pixels = 2.0f, .batch = 5}, .grain = 16});
       REQUIRE(r.ok());
       auto rep = r->run(infolerp::support::brute_force_tracer{&m}, cam, shade, exec);

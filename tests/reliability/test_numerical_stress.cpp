@@ -130,7 +130,7 @@ TEST_CASE("stress: coordinates scaled by 1e30 and 1e-30", "[reliability][stress]
     }
 
     // Subdivision at scale: midpoints are the scaled midpoints (one float rounding each).
-    auto sub = infolerp::subdivision_mesh::build(ms);
+    auto sub = infolerp::subdivision_mesh::create(ms);
     REQUIRE(sub.ok());
     for (std::uint32_t t = 0; t < 40; t += 3) REQUIRE(sub->split(t).ok());
     for (const auto& p : sub->positions()) CHECK((std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)));
@@ -180,8 +180,8 @@ TEST_CASE("stress: float against double inputs", "[reliability][stress]") {
     const infolerp::reliability::table_source src{ids, 5};
     std::vector<glm::vec3> f(40 * 30);
     std::vector<glm::dvec3> d(40 * 30);
-    REQUIRE(infolerp::upsample(src, 40, 30, std::span<glm::vec3>(f), infolerp::serial_executor{}).ok());
-    REQUIRE(infolerp::upsample(src, 40, 30, std::span<glm::dvec3>(d), infolerp::serial_executor{}).ok());
+    REQUIRE(infolerp::upsample(src, 40, 30, std::span<glm::vec3>(f)).ok());
+    REQUIRE(infolerp::upsample(src, 40, 30, std::span<glm::dvec3>(d)).ok());
     for (std::size_t i = 0; i < f.size(); ++i) CHECK(glm::dvec3(f[i]) == d[i]);
   }
 }
@@ -220,7 +220,7 @@ TEST_CASE("stress: slivers with angles near 0 and 180 degrees", "[reliability][s
       for (const auto& at : table->clusters) CHECK(std::isfinite(at.peak_normal_deviation));
     }
     // Subdivision of the slivers: children finite, the mesh stays conforming.
-    auto sub = infolerp::subdivision_mesh::build(m, {.bisect_ratio = 0.0f});
+    auto sub = infolerp::subdivision_mesh::create(m, {.bisect_ratio = 0.0f});
     REQUIRE(sub.ok());
     const auto first = static_cast<std::uint32_t>(m.triangles.size() - 3);
     for (int round = 0; round < 6; ++round) REQUIRE(sub->split(static_cast<std::uint32_t>(sub->triangle_count() - 1)).ok());
@@ -241,7 +241,7 @@ TEST_CASE("stress: 300 nested selections (deeper than the 255 levels a triangle 
   // ~30 levels, yet the hierarchy must stay a conforming triangulation and the level count
   // must saturate (it used to assert, or wrap to 0 without assertions).
   const indexed_mesh m = infolerp::support::make_plane(1, 1, 1.0f);
-  auto s = infolerp::subdivision_mesh::build(m);
+  auto s = infolerp::subdivision_mesh::create(m);
   REQUIRE(s.ok());
   std::uint32_t t = 0;
   for (int i = 0; i < 300; ++i) {
@@ -318,7 +318,7 @@ TEST_CASE("stress: thresholds at exactly 0 and 1", "[reliability][stress]") {
       for (float s_req : {0.0f, 1.0f}) {
         INFO(infolerp::to_string(criterion) << " s_req " << s_req);
         auto r = infolerp::progressive_refiner::create(
-            *infolerp::subdivision_mesh::build(m),
+            *infolerp::subdivision_mesh::create(m),
             {.criteria = {.criterion = criterion, .s_req = s_req, .min_pixels = 1.0f, .always_refine_fraction = 1.0f},
              .max_batches = 20});
         REQUIRE(r.ok());
@@ -357,14 +357,14 @@ TEST_CASE("stress: thresholds at exactly 0 and 1", "[reliability][stress]") {
     auto d = infolerp::distribute_contractions(prio, cap, 10, 1.0);
     REQUIRE(d.ok());
     CHECK(std::accumulate(d->begin(), d->end(), std::uint64_t{0}) == 10);
-    auto sub = infolerp::subdivision_mesh::build(infolerp::support::make_plane(3, 3, 1.0f), {.bisect_ratio = 0.0f});
+    auto sub = infolerp::subdivision_mesh::create(infolerp::support::make_plane(3, 3, 1.0f), {.bisect_ratio = 0.0f});
     REQUIRE(sub.ok());
     REQUIRE(sub->split(4u).ok());
     CHECK(infolerp::pass_controller::create({.min_frame_seconds = 0.02, .max_frame_seconds = 0.02, .smoothing = 1.0}).ok());
     const std::uint32_t ids[1] = {0};
     const infolerp::reliability::table_source src{ids, 1};
     std::vector<glm::vec3> px(1);
-    CHECK(infolerp::upsample(src, 1, 1, std::span<glm::vec3>(px), infolerp::serial_executor{},
+    CHECK(infolerp::upsample(src, 1, 1, std::span<glm::vec3>(px),
                              {.passes = infolerp::max_upsample_passes, .max_passes = infolerp::max_upsample_passes})
               .ok());
   }

@@ -168,6 +168,6 @@ TEST_CASE("render_controlled drives a real upsampler", "[upsample][controller]")
 
   auto big = infolerp::pass_controller::create({.max_passes = 5});
   REQUIRE(big.ok());
-  CHECK(infolerp::render_controlled(*up, *big, src, std::span<float>(out), infolerp::serial_executor{}).code() ==
+  CHECK(infolerp::render_controlled(*up, *big, src, std::span<float>(out)).code() ==  // executor defaulted
         infolerp::errc::bad_parameter);
 }

@@ -27,6 +27,7 @@
 #include <glm/vec3.hpp>
 #include "infolerp/cluster/channel.hpp"
 #include "infolerp/cluster/region_growing.hpp"
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 
 namespace infolerp {
@@ -301,16 +302,10 @@ std::uint32_t smooth_boundaries(const S& s, const element_graph& g, const M& m, 
       return static_cast<std::uint32_t>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
     };
     // Adjacency (CSR, each vertex's neighbours in `edges` order).
-    adj_offsets.assign(verts.size() + 1, 0);
-    adj.resize(2 * edges.size());
-    for (std::uint32_t v : end_vertex) ++adj_offsets[v + 1];
-    for (std::size_t i = 0; i < verts.size(); ++i) adj_offsets[i + 1] += adj_offsets[i];
-    from.assign(adj_offsets.begin(), adj_offsets.end() - 1);  // fill cursors, reused below
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-      const std::uint32_t a = end_vertex[2 * e], b = end_vertex[2 * e + 1];
-      adj[from[a]++] = b;
-      adj[from[b]++] = a;
-    }
+    // End 2e + j of edge e lists the other end, 2e + 1 - j, under its own vertex.
+    detail::group_by_key(
+        verts.size(), end_vertex.size(), [&](std::size_t i) { return end_vertex[i]; },
+        [&](std::size_t i) { return end_vertex[i ^ 1]; }, adj_offsets, adj);
     pos.resize(verts.size());
     for (std::size_t i = 0; i < verts.size(); ++i) pos[i] = glm::dvec3(mesh_position(m, verts[i]));
     const std::uint32_t start = vid(endpoints[0]), goal = vid(endpoints[1]);

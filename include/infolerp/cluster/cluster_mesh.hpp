@@ -28,6 +28,7 @@
 #include "infolerp/cluster/region_growing.hpp"
 #include "infolerp/cluster/stretch_channel.hpp"
 #include "infolerp/cluster/visibility_channel.hpp"
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
@@ -94,14 +95,11 @@ status run_channel(const P& ch, const M& m, const mesh_topology& topo, const clu
     }
   }
   const std::size_t nt = label.size();
-  // Triangles of each cluster, ascending (counting sort).
-  std::vector<std::uint32_t> offsets(count + 1, 0), tris(nt);
-  for (std::uint32_t l : label) ++offsets[l + 1];
-  for (std::uint32_t k = 0; k < count; ++k) offsets[k + 1] += offsets[k];
-  {
-    std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t t = 0; t < nt; ++t) tris[cursor[label[t]]++] = t;
-  }
+  // Triangles of each cluster, ascending.
+  std::vector<std::uint32_t> offsets, tris;
+  detail::group_by_key(
+      count, nt, [&](std::size_t t) { return label[t]; }, [](std::size_t t) { return static_cast<std::uint32_t>(t); },
+      offsets, tris);
   std::vector<std::uint32_t> scratch(nt, invalid_id), next(nt);
   std::uint32_t next_count = 0;
   const region_growing_options go{static_cast<double>(ch.threshold), o.min_cluster_fraction, o.grain, nt};

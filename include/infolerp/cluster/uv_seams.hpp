@@ -30,6 +30,7 @@
 #include <vector>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/topology.hpp"
@@ -164,13 +165,10 @@ result<seam_clustering> split_at_uv_seams(const M& m, std::span<const std::uint3
       }
     out.seam_edges += seam_edge ? 1 : 0;
   }
-  std::vector<std::uint32_t> offsets(nt + 1, 0), joined(pairs.size());
-  for (const auto& p : pairs) ++offsets[p.x + 1];
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  {
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (const auto& p : pairs) joined[fill[p.x]++] = p.y;
-  }
+  std::vector<std::uint32_t> offsets, joined;
+  detail::group_by_key(
+      nt, pairs.size(), [&](std::size_t i) { return pairs[i].x; }, [&](std::size_t i) { return pairs[i].y; }, offsets,
+      joined);
   std::vector<std::uint32_t> label(nt, invalid_id);
   std::uint32_t count = label_unlabelled_components(
       label, 0, [&](std::uint32_t t) { return std::span<const std::uint32_t>(joined.data() + offsets[t], joined.data() + offsets[t + 1]); },

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <span>
 #include <vector>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
@@ -43,13 +44,10 @@ result<split_clusters_result> split_clusters(const M& m, std::span<const std::ui
     return make_error(errc::bad_parameter, no_element, "max_vertices ", max_vertices, " must be at least 3");
   // Triangles grouped by cluster, Morton order inside each (a stable counting sort of the curve).
   const std::vector<std::uint32_t> curve = morton_triangle_order(m);
-  std::vector<std::uint32_t> offsets(cluster_count + 1, 0), grouped(nt);
-  for (std::size_t t = 0; t < nt; ++t) ++offsets[cluster[t] + 1];
-  for (std::uint32_t c = 0; c < cluster_count; ++c) offsets[c + 1] += offsets[c];
-  {
-    std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t t : curve) grouped[cursor[cluster[t]]++] = t;
-  }
+  std::vector<std::uint32_t> offsets, grouped;
+  detail::group_by_key(
+      cluster_count, nt, [&](std::size_t i) { return cluster[curve[i]]; }, [&](std::size_t i) { return curve[i]; },
+      offsets, grouped);
   split_clusters_result out;
   out.cluster.resize(nt);
   out.first_part.assign(cluster_count + 1, 0);

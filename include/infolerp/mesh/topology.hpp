@@ -14,6 +14,7 @@
 #include <vector>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 
@@ -46,8 +47,8 @@ struct mesh_topology {
 // Builds the topology of any infolerp::mesh.
 // Errors: an index >= vertex_count (names the triangle and corner), more than 2^32/3-1 triangles.
 // Complexity: O(V + T), plus a sort of each vertex's edge bucket (tiny except at poles).
-// Allocation: about 60 bytes per triangle plus 4 per vertex; nothing kept after return
-// except the result.
+// Allocation: the result, about 60 bytes per triangle, and temporaries freed on return (48
+// bytes per triangle plus 4 per vertex).
 template <class M>
 result<mesh_topology> build_topology(const M& m) {
   static_assert(check_mesh<M>());
@@ -59,36 +60,30 @@ result<mesh_topology> build_topology(const M& m) {
     return make_error(errc::unsupported, nv, "mesh has ", nv, " vertices; at most 4294967294 are supported");
 
   mesh_topology topo;
-  std::vector<glm::uvec3> tris(nt);
-  std::vector<std::uint32_t> start(nv + 1, 0);
+  // Each half-edge 3t + c as its two ends (corner c, corner c + 1 of triangle t).
+  std::vector<glm::uvec2> half(3 * nt);
   for (std::size_t t = 0; t < nt; ++t) {
     const glm::uvec3 tri = mesh_triangle(m, t);
     for (int c = 0; c < 3; ++c)
       if (tri[c] >= nv)
         return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
                           " out of range (vertex count ", nv, ")");
-    tris[t] = tri;
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
-      if (a != b) ++start[std::min(a, b) + 1];
-    }
+    half[3 * t] = {tri.x, tri.y}, half[3 * t + 1] = {tri.y, tri.z}, half[3 * t + 2] = {tri.z, tri.x};
   }
-  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
 
-  // Half-edges bucketed by their smaller vertex: (larger vertex, half-edge id = 3t + c).
+  // Half-edges bucketed by their smaller vertex: (larger vertex, half-edge id); a half-edge
+  // (a, a) of a degenerate triangle is no edge.
   struct half_edge {
     std::uint32_t hi, id;
     bool operator<(const half_edge& o) const { return hi != o.hi ? hi < o.hi : id < o.id; }
   };
-  std::vector<half_edge> buckets(start[nv]);
-  {
-    std::vector<std::uint32_t> cursor(start.begin(), start.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t)
-      for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tris[t][c], b = tris[t][(c + 1) % 3];
-        if (a != b) buckets[cursor[std::min(a, b)]++] = {std::max(a, b), static_cast<std::uint32_t>(3 * t) + static_cast<std::uint32_t>(c)};
-      }
-  }
+  std::vector<std::uint32_t> start;
+  std::vector<half_edge> buckets;
+  detail::group_by_key(
+      nv, half.size(),
+      [&](std::size_t h) { return half[h].x == half[h].y ? detail::no_bucket : std::min(half[h].x, half[h].y); },
+      [&](std::size_t h) { return half_edge{std::max(half[h].x, half[h].y), static_cast<std::uint32_t>(h)}; },
+      start, buckets);
 
   topo.triangle_edges.assign(3 * nt, invalid_id);
   topo.edge_faces.reserve(buckets.size());

@@ -186,8 +186,8 @@ class progressive_refiner {
   // mesh does not have or with a non-finite distance or barycentric (names the pixel). On error
   // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level);
   // allocation O(pixels + triangles + vertices).
-  template <class T, class Camera, class E>
-  status set_view(const T& tracer, const Camera& camera, E&& exec) {
+  template <class T, class Camera, class E = serial_executor>
+  status set_view(const T& tracer, const Camera& camera, E&& exec = E{}) {
     return view(tracer, camera, exec, false);
   }
 
@@ -274,14 +274,14 @@ class progressive_refiner {
   // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
   // Preconditions: a view was set. Complexity per batch: the criterion's selection
   // (criteria.hpp) + O(R) splits + O(pixels) re-location + O(visible · level).
-  template <class E>
-  refine_progress refine(E&& exec, refine_budget budget = {}) {
+  template <class E = serial_executor>
+  refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
   }
   // As above with a synchronous renderer: each batch's requests are shaded at once, so the
   // budget's batches, samples and seconds all apply.
-  template <class Shade, class E>
-  refine_progress refine(Shade&& shade, E&& exec, refine_budget budget = {}) {
+  template <class Shade, class E = serial_executor>
+  refine_progress refine(Shade&& shade, refine_budget budget = {}, E&& exec = E{}) {
     static_assert(check_shade<Shade>());
     return refine_impl(exec, budget, [&](E& ex) { shade_requests(shade, ex); });
   }
@@ -289,13 +289,13 @@ class progressive_refiner {
   // One batch of stage 2 with the synchronous renderer. Returns false when nothing was
   // selected, the shading budget is reached, max_batches ran or the cache is full (then stage
   // 2's figures are final). Preconditions: start() or set_view() succeeded.
-  template <class Shade, class E>
-  bool refine_batch(Shade&& shade, E&& exec) {
+  template <class Shade, class E = serial_executor>
+  bool refine_batch(Shade&& shade, E&& exec = E{}) {
     if (done()) {
       report_.budget_reached = !finished_;
       return false;
     }
-    const refine_progress p = refine(shade, exec, refine_budget{.batches = 1});
+    const refine_progress p = refine(shade, refine_budget{.batches = 1}, exec);
     if (p != refine_progress::refined) {
       report_.budget_reached = p == refine_progress::cache_full;
       return false;
@@ -309,8 +309,8 @@ class progressive_refiner {
 
   // start() then batches until done. Returns the Table 1 figures. Errors, complexity and
   // allocation: those of start() plus every refine_batch().
-  template <class T, class Camera, class Shade, class E>
-  result<refinement_report> run(const T& tracer, const Camera& camera, Shade&& shade, E&& exec) {
+  template <class T, class Camera, class Shade, class E = serial_executor>
+  result<refinement_report> run(const T& tracer, const Camera& camera, Shade&& shade, E&& exec = E{}) {
     if (auto st = start(tracer, camera, shade, exec); !st) return st;
     while (refine_batch(shade, exec)) {
     }

@@ -227,7 +227,7 @@ class subdivision_mesh {
   // triangle (repeated index or zero area); an edge shared by more than two triangles;
   // bisect_ratio negative or NaN. Complexity O(V + T) expected; allocation O(V + T).
   template <class M>
-  static result<subdivision_mesh> build(const M& m, subdivision_options options = {}) {
+  static result<subdivision_mesh> create(const M& m, subdivision_options options = {}) {
     static_assert(check_mesh<M>());
     if (!(options.bisect_ratio >= 0.0f))
       return make_error(errc::bad_parameter, no_element, "bisect_ratio ", options.bisect_ratio, " must be >= 0");
@@ -379,13 +379,13 @@ class subdivision_mesh {
 
   // The leaves as a mesh that carries the input mesh's attributes, so that a mesh tessellated
   // for a view (§4.1) clusters, traces and upsamples like any other. `source` is the mesh
-  // build() read. Each leaf's corners get the barycentric weights of their positions in the
+  // create() read. Each leaf's corners get the barycentric weights of their positions in the
   // leaf's original triangle (subdivision is flat, so the weights are exact up to rounding);
   // per-corner texcoords are interpolated with them within that triangle (UV seams stay
   // seams), and every new vertex's normal (renormalised) and keyframe positions within the
   // triangle it was created in. leaf_source[i] = the original triangle of leaf i, so per-
   // triangle data (cluster ids) carries over as leaf_source[i] -> data[leaf_source[i]].
-  // Errors: source's vertex or triangle count differs from build()'s (bad_size); a keyframe
+  // Errors: source's vertex or triangle count differs from create()'s (bad_size); a keyframe
   // without a position per vertex (bad_size, naming it).
   // Complexity O(V + triangle_count() + V·keyframes); allocates the mesh and leaf_source.
   template <class M>

@@ -43,6 +43,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
@@ -119,13 +120,10 @@ face_data make_face_data(const M& m, const mesh_topology& topo, std::span<const 
       if (e != invalid_id && topo.is_boundary_edge(e)) fd.on_boundary[i] = 1;
     }
   }
-  fd.vf_offsets.assign(nv + 1, 0), fd.vf.resize(3 * nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) ++fd.vf_offsets[mesh_triangle(m, t)[c] + 1];
-  for (std::size_t v = 0; v < nv; ++v) fd.vf_offsets[v + 1] += fd.vf_offsets[v];
-  std::vector<std::uint32_t> cursor(fd.vf_offsets.begin(), fd.vf_offsets.end() - 1);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) fd.vf[cursor[mesh_triangle(m, t)[c]]++] = internal[t];
+  // Corner 3t + c of triangle t lists internal[t] under its vertex.
+  detail::group_by_key(
+      nv, 3 * nt, [&](std::size_t k) { return std::uint32_t{mesh_triangle(m, k / 3)[static_cast<int>(k % 3)]}; },
+      [&](std::size_t k) { return internal[k / 3]; }, fd.vf_offsets, fd.vf);
   return fd;
 }
 
@@ -467,13 +465,10 @@ result<std::vector<double>> cluster_localized_saliency(const M& m, std::span<con
   std::vector<double> count(cluster_count, 0.0);
   std::vector<std::uint32_t> last_seen(nv, invalid_id);  // per vertex: last cluster that counted it
   // Visit triangles cluster by cluster so "each vertex once per cluster" needs O(V) memory.
-  std::vector<std::uint32_t> by_cluster(nt), offsets(cluster_count + 1, 0);
-  for (std::size_t t = 0; t < nt; ++t) ++offsets[cluster[t] + 1];
-  for (std::size_t c = 0; c < cluster_count; ++c) offsets[c + 1] += offsets[c];
-  {
-    std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (std::size_t t = 0; t < nt; ++t) by_cluster[cursor[cluster[t]]++] = static_cast<std::uint32_t>(t);
-  }
+  std::vector<std::uint32_t> by_cluster, offsets;
+  detail::group_by_key(
+      cluster_count, nt, [&](std::size_t t) { return cluster[t]; }, [](std::size_t t) { return static_cast<std::uint32_t>(t); },
+      offsets, by_cluster);
   for (std::uint32_t c = 0; c < cluster_count; ++c)
     for (std::uint32_t k = offsets[c]; k < offsets[c + 1]; ++k) {
       const glm::uvec3 tri = mesh_triangle(m, by_cluster[k]);

@@ -146,9 +146,9 @@ class pass_controller {
 // One controlled frame: renders with the controller's pass count, then feeds it the frame time
 // the upsampler measured (stats().seconds). Errors: the controller's max_passes above the
 // upsampler's (errc::bad_parameter), and those of upsampler::render. Allocation: none.
-template <class Sample, class Clock, class S, class Pixel, class E>
+template <class Sample, class Clock, class S, class Pixel, class E = serial_executor>
 [[nodiscard]] status render_controlled(upsampler<Sample, Clock>& up, pass_controller& controller, const S& src,
-                                       std::span<Pixel> out, E&& exec) {
+                                       std::span<Pixel> out, E&& exec = E{}) {
   static_assert(check_sample_source<S>());
   static_assert(check_executor<std::remove_cvref_t<E>>());
   if (controller.options().max_passes > up.options().max_passes)

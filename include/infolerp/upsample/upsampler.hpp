@@ -203,8 +203,8 @@ class upsampler {
   // E ≈ (W·H)/4^(passes−1) + (cluster and shadow boundary samples). Allocation: none.
   // Thread-safety: src's const members are called concurrently (see sample_source.hpp).
   // Output is bit-identical for every executor and thread count.
-  template <class S, class Pixel, class E>
-  [[nodiscard]] status render(const S& src, std::span<Pixel> out, E&& exec) {
+  template <class S, class Pixel, class E = serial_executor>
+  [[nodiscard]] status render(const S& src, std::span<Pixel> out, E&& exec = E{}) {
     static_assert(check_sample_source<S>());
     static_assert(check_executor<std::remove_cvref_t<E>>());
     static_assert(std::same_as<typename S::sample_type, Sample>,
@@ -249,12 +249,6 @@ class upsampler {
     }
     stats_.seconds = seconds_since(frame_start);
     return {};
-  }
-
-  // Serial render.
-  template <class S, class Pixel>
-  [[nodiscard]] status render(const S& src, std::span<Pixel> out) {
-    return render(src, out, serial_executor{});
   }
 
   // Accessors: O(1), no allocation; spans stay valid until the next resize().
@@ -491,9 +485,9 @@ class upsampler {
 // One-shot upsampling into out (width·height pixels) with a temporary pyramid.
 // Errors as upsampler::create and upsampler::render. Allocation: the pyramid (see create).
 // Prefer a kept `upsampler` for every-frame use.
-template <class S, class Pixel, class E>
+template <class S, class Pixel, class E = serial_executor>
 [[nodiscard]] status upsample(const S& src, std::uint32_t width, std::uint32_t height, std::span<Pixel> out,
-                              E&& exec, upsampler_options options = {}) {
+                              upsampler_options options = {}, E&& exec = E{}) {
   static_assert(check_sample_source<S>());
   options.max_passes = std::max(options.max_passes, options.passes);
   auto u = upsampler<typename S::sample_type>::create(width, height, options);
