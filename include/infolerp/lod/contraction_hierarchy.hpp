@@ -34,6 +34,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include "infolerp/core/detail/csr.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/curvature.hpp"
@@ -368,21 +369,22 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   }
   // Vertex → triangle adjacency, ascending triangle ids, every triangle under each distinct corner.
   auto distinct = [](const glm::uvec3& f, int j) { return j == 0 || (f[j] != f.x && (j == 1 || f.z != f.y)); };
-  cm.first.assign(nv + 1, 0);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 f = mesh_triangle(m, t);
-    for (int j = 0; j < 3; ++j)
-      if (distinct(f, j)) ++cm.first[f[j] + 1];
-  }
-  for (std::size_t v = 0; v < nv; ++v) cm.first[v + 1] += cm.first[v];
-  cm.fan.reserve(2 * std::size_t{cm.first[nv]});  // room for slices moved to the end, without reallocation copies
-  cm.fan.resize(cm.first[nv]);
-  cm.count.assign(nv, 0);
-  for (std::uint32_t t = 0; t < nt; ++t) {
-    const glm::uvec3 f = mesh_triangle(m, t);
-    for (int j = 0; j < 3; ++j)
-      if (distinct(f, j)) cm.fan[cm.first[f[j]] + cm.count[f[j]]++] = {3 * t + static_cast<std::uint32_t>(j), f[(j + 1) % 3], f[(j + 2) % 3]};
-  }
+  cm.fan.reserve(6 * nt);  // room for slices moved to the end, without reallocation copies
+  detail::group_by_key(
+      nv, 3 * nt,
+      [&](std::size_t c) {
+        const glm::uvec3 f = mesh_triangle(m, c / 3);
+        const int j = static_cast<int>(c % 3);
+        return distinct(f, j) ? f[j] : detail::no_bucket;
+      },
+      [&](std::size_t c) {
+        const glm::uvec3 f = mesh_triangle(m, c / 3);
+        const int j = static_cast<int>(c % 3);
+        return detail::fan_entry{static_cast<std::uint32_t>(c), f[(j + 1) % 3], f[(j + 2) % 3]};
+      },
+      cm.first, cm.fan);
+  cm.count.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) cm.count[v] = cm.first[v + 1] - cm.first[v];
   // Edges (a, b), a < b, from a's triangles in ascending (a, b): more than two distinct triangles
   // is an error; one makes a boundary edge, held by a plane through it perpendicular to its
   // (lowest-index) triangle.
@@ -560,23 +562,13 @@ result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<
   }
 
   if (local_phase) h.local_contractions = static_cast<std::uint32_t>(h.removed.size());
-  // Per-cluster contraction lists and cross-cluster dependencies (counting sorts, stable).
-  h.cluster_offsets.assign(cluster_count + 1, 0);
-  for (std::uint32_t c : h.owner) ++h.cluster_offsets[c + 1];
-  for (std::uint32_t c = 0; c < cluster_count; ++c) h.cluster_offsets[c + 1] += h.cluster_offsets[c];
-  h.cluster_contractions.resize(h.owner.size());
-  {
-    std::vector<std::uint32_t> cursor(h.cluster_offsets.begin(), h.cluster_offsets.end() - 1);
-    for (std::uint32_t i = 0; i < h.owner.size(); ++i) h.cluster_contractions[cursor[h.owner[i]]++] = i;
-  }
-  h.cross_offsets.assign(cluster_count + 1, 0);
-  for (const auto& x : crossing) ++h.cross_offsets[x.first + 1];
-  for (std::uint32_t c = 0; c < cluster_count; ++c) h.cross_offsets[c + 1] += h.cross_offsets[c];
-  h.cross.resize(crossing.size());
-  {
-    std::vector<std::uint32_t> cursor(h.cross_offsets.begin(), h.cross_offsets.end() - 1);
-    for (const auto& x : crossing) h.cross[cursor[x.first]++] = x.second;
-  }
+  // Per-cluster contraction lists and cross-cluster dependencies (stable, in contraction order).
+  detail::group_by_key(
+      cluster_count, h.owner.size(), [&](std::size_t i) { return h.owner[i]; },
+      [](std::size_t i) { return static_cast<std::uint32_t>(i); }, h.cluster_offsets, h.cluster_contractions);
+  detail::group_by_key(
+      cluster_count, crossing.size(), [&](std::size_t i) { return crossing[i].first; },
+      [&](std::size_t i) { return crossing[i].second; }, h.cross_offsets, h.cross);
   // Index buffer grouped by cluster, then by the removing contraction's owner, latest removal
   // first (see the struct); ties keep the input order.
   h.triangle_offsets.assign(cluster_count + 1, 0);
