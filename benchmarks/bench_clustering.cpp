@@ -114,7 +114,7 @@ elephant_scene make_elephant(bool ordered) {
   e.mesh = std::move(*m);
   if (ordered) reorder_for_locality(e.mesh);
   add_spherical_texcoords(e.mesh);
-  e.topo = std::move(*build_topology(e.mesh));
+  e.topo = std::move(*make_topology(e.mesh));
   e.device = std::make_unique<support::embree_device>("threads=1");
   e.tracer = std::make_unique<support::embree_scene>(*e.device);
   if (!e.tracer->add_mesh(e.mesh) || !e.tracer->commit()) return e;
@@ -226,7 +226,7 @@ template <class Make>
 void direct_channel_bench(benchmark::State& state, const indexed_mesh& m, Make make_state, double threshold) {
   const auto bins = static_cast<std::uint32_t>(state.range(0));
   const bool exact_rows = state.range(1) != 0;
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   std::vector<std::uint32_t> all(m.triangles.size()), scratch(m.triangles.size(), invalid_id);
   std::iota(all.begin(), all.end(), 0u);
   const element_graph g = subset_graph(*topo, all, scratch);

@@ -16,7 +16,7 @@ static void BM_Topology_RefinedElephant(benchmark::State& state) {
     return;
   }
   for (auto _ : state) {
-    auto topo = infolerp::build_topology(*m);
+    auto topo = infolerp::make_topology(*m);
     benchmark::DoNotOptimize(topo);
   }
   state.counters["triangles"] = static_cast<double>(m->triangles.size());

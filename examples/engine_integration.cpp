@@ -120,7 +120,7 @@ int main() {
   engine::Mesh broken = mesh;
   broken.indices[7] = 100000;
   std::printf("broken mesh: %s\n", infolerp::validate_mesh(broken).message().c_str());
-  const auto topo = infolerp::build_topology(mesh);
+  const auto topo = infolerp::make_topology(mesh);
   if (!topo) return 1;
   std::printf("mesh: %zu vertices, %zu triangles, %zu edges, %u components\n", infolerp::mesh_vertex_count(mesh),
               infolerp::mesh_triangle_count(mesh), topo->edge_count(), infolerp::connected_components(*topo).count);

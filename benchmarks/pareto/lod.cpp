@@ -133,7 +133,7 @@ void simplify_rows(std::FILE* csv, const support::embree_device& device, const s
   contraction_hierarchy h;
   for (int r = 0; r < reps; ++r) {
     auto t0 = clk::now();
-    auto built = build_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .cluster_local_first = false});
+    auto built = make_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .cluster_local_first = false});
     build_s[static_cast<std::size_t>(r)] = seconds_since(t0);
     if (!built.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), built.error().message().c_str()));
     h = std::move(*built);
@@ -187,7 +187,7 @@ void frame_rows(std::FILE* csv, int reps) {
   prepared p;
   if (!prepare(m, p)) return;
   const auto t0 = clk::now();
-  auto h = build_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count);
+  auto h = make_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count);
   const double build = seconds_since(t0);
   if (!h.ok()) return void(std::fprintf(stderr, "%s\n", h.error().message().c_str()));
   auto table = compute_cluster_attributes(m, p.saliency, p.clusters.cluster, p.clusters.count);

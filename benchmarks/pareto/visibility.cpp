@@ -175,7 +175,7 @@ void report_peak_memory(const std::string& name, const config& c) {
     close(fd[0]);
     double out[3] = {0.0, 0.0, 0.0};
     auto m = support::load_mesh(support::cgal_mesh(name));
-    auto topo = m ? build_topology(*m) : result<mesh_topology>(make_error(errc::empty_input, no_element, "no mesh"));
+    auto topo = m ? make_topology(*m) : result<mesh_topology>(make_error(errc::empty_input, no_element, "no mesh"));
     if (m && topo) {
       support::embree_device device("threads=1");
       support::embree_scene scene(device, {.coherent_streams = c.stream});
@@ -280,7 +280,7 @@ int pareto_visibility(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), m.error().message().c_str());
       return 1;
     }
-    auto topo = build_topology(*m);
+    auto topo = make_topology(*m);
     support::embree_device device("threads=1");
     support::embree_scene scene(device);
     support::embree_scene stream_scene(device, {.coherent_streams = true});

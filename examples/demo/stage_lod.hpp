@@ -110,7 +110,7 @@ inline bool stage_lod(demo_context& ctx) {
   if (!cl) return report(cl.error()), false;
   auto w = weighting_map(m, sal->saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
-  auto h = build_contraction_hierarchy(m, *w, cl->cluster, cl->count);
+  auto h = make_contraction_hierarchy(m, *w, cl->cluster, cl->count);
   if (!h) return report(h.error()), false;
   auto table = compute_cluster_attributes(m, sal->saliency, cl->cluster, cl->count);
   if (!table) return report(table.error()), false;

@@ -3,8 +3,9 @@
 // translation unit that includes only the headers it uses parses less.
 // Convention: an entry point takes its inputs, then its options, then the executor, options and
 // executor defaulted (serial_executor) where the call stays unambiguous (cluster_mesh and
-// cluster_keyframes take the executor before their trailing pack of channels), and a type whose
-// construction can fail is made by its static `create`, which returns result<T>.
+// cluster_keyframes take the executor before their trailing pack of channels); a type whose
+// construction can fail is made by its static `create`, which returns result<T>, and a free
+// function that makes a new value is named make_<what> (make_topology, make_contraction_hierarchy).
 
 // Entry points: what an engine calls.
 #include "infolerp/cluster/cluster_mesh.hpp"             // Algorithm 1: cluster ids per triangle

@@ -169,7 +169,7 @@ TEST_CASE("stretch exact rows equal the brute-force M x M channel", "[cluster][s
 TEST_CASE("stretch channel is skipped on meshes without texcoords", "[cluster][stretch]") {
   const auto m = support::make_icosphere(1);
   serial_executor exec;
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   auto p = stretch_channel{}.prepare(m, *topo, 0, exec);
   REQUIRE(p.ok());
@@ -189,7 +189,7 @@ TEST_CASE("visibility: Bayes inversion, occlusion and unseen triangles", "[clust
   support::append(scene, support::make_plane(1, 1, 0.1f), glm::translate(glm::mat4(1.0f), glm::vec3(3, 3, 0)));
   support::append(scene, support::make_box({2.8f, 2.8f, -0.2f}, {3.2f, 3.2f, 0.2f}));
   test::brute_tracer tracer(scene);
-  auto topo = build_topology(scene);
+  auto topo = make_topology(scene);
   REQUIRE(topo.ok());
   serial_executor exec;
   std::size_t calls = 0, last = 0;
@@ -277,7 +277,7 @@ static sphere_under_roof make_sphere_under_roof() {
   sphere_under_roof r{support::make_uv_sphere(16, 10), {}, {}};
   support::append(r.scene, support::make_plane(2, 2, 0.8f), glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1.3f)));
   test::brute_tracer tracer(r.scene);
-  auto topo = build_topology(r.scene);
+  auto topo = make_topology(r.scene);
   REQUIRE(topo.ok());
   r.topo = std::move(*topo);
   serial_executor exec;
@@ -488,7 +488,7 @@ TEST_CASE("stretch binned with exact rows: per-cell sums of the exact rows, exac
   const auto big = support::make_uv_sphere(64, 32);
   const auto big_raw = texture_stretch(big);
   REQUIRE(big_raw.ok());
-  auto topo = build_topology(big);
+  auto topo = make_topology(big);
   REQUIRE(topo.ok());
   const auto all = all_triangles(big.triangles.size());
   std::vector<std::uint32_t> scratch(all.size(), invalid_id);

@@ -37,7 +37,7 @@ void check_invariants(const M& m, const mesh_clustering& c) {
     if (l == next) ++next;
   }
   REQUIRE(next == c.cluster_count);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   // Components of the dual graph restricted to same-cluster neighbours: one per cluster.
   std::vector<std::uint32_t> comp(c.cluster_of.size(), invalid_id), stack;
@@ -387,7 +387,7 @@ TEST_CASE("estimates change no result: Algorithm 1 with and without estimate()",
   support::embree_scene scene(device);
   REQUIRE(scene.add_mesh(*m).ok());
   REQUIRE(scene.commit().ok());
-  auto topo = build_topology(*m);
+  auto topo = make_topology(*m);
   REQUIRE(topo.ok());
   auto vis = visibility_channel{.viewpoints = 32, .samples_per_side = 1}.prepare(*m, *topo, scene, serial);
   REQUIRE(vis.ok());
@@ -437,7 +437,7 @@ TEST_CASE("boundary smoothing straightens a jagged boundary and never touches a 
   const std::size_t n = m.triangles.size();
   std::vector<std::uint32_t> all(n), scratch(n, invalid_id);
   std::iota(all.begin(), all.end(), 0u);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   const element_graph g = subset_graph(*topo, all, scratch);
   // A 1-D feature (the centroid's x) as a stretch-like channel: JS grows with |Δx|.

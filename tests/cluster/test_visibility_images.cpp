@@ -78,7 +78,7 @@ TEST_CASE("visibility images: OR of a square partly hidden behind another matche
           "[cluster][visibility]") {
   const indexed_mesh m = square_under_occluder();
   traced_scene ts(m);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
   const visibility_channel c{.viewpoints = 64, .radius_scale = 3.0, .images = true, .image_resolution = 512,
@@ -114,7 +114,7 @@ TEST_CASE("visibility images: triangles under image_min_pixels use the sample ra
   indexed_mesh m = support::make_plane(6, 6, 2.0f);
   support::append(m, support::make_box({-0.3f, -0.3f, 0.05f}, {0.3f, 0.3f, 0.5f}));
   traced_scene ts(m);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
   const visibility_channel rays{.viewpoints = 40, .samples_per_side = 3};
@@ -137,7 +137,7 @@ TEST_CASE("visibility images: the same counts for any executor", "[cluster][visi
   indexed_mesh m = support::make_torus(24, 12, 1.0f, 0.4f);
   support::append(m, support::make_plane(4, 4, 4.0f));
   traced_scene ts(m);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   const visibility_channel c{.viewpoints = 20, .images = true, .image_resolution = 96, .image_min_pixels = 2.0};
   serial_executor serial;
@@ -152,7 +152,7 @@ TEST_CASE("visibility images: the same counts for any executor", "[cluster][visi
 TEST_CASE("visibility images: bad options get a status naming them", "[cluster][visibility]") {
   const indexed_mesh m = square_under_occluder();
   traced_scene ts(m);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
   auto fails_naming = [&](visibility_channel c, const std::string& what) {

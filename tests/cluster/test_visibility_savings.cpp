@@ -46,7 +46,7 @@ void require_exact_savings(const indexed_mesh& m, std::uint32_t viewpoints, std:
   REQUIRE(scene.commit().ok());
   REQUIRE(stream.add_mesh(m).ok());
   REQUIRE(stream.commit().ok());
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
   const visibility_channel plain{.viewpoints = viewpoints, .samples_per_side = n};
@@ -132,7 +132,7 @@ TEST_CASE("visibility adaptive sampling: the probe rule, its bound, and determin
   support::embree_scene scene(device);
   REQUIRE(scene.add_mesh(m).ok());
   REQUIRE(scene.commit().ok());
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   REQUIRE(topo.ok());
   serial_executor serial;
   const std::uint32_t n = 3, ns = n * n;

@@ -8,4 +8,4 @@ struct no_triangles {
   glm::vec3 position(std::size_t) const { return {}; }
 };
 
-int main() { return infolerp::build_topology(no_triangles{}).ok() ? 0 : 1; }
+int main() { return infolerp::make_topology(no_triangles{}).ok() ? 0 : 1; }

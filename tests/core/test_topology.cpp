@@ -33,7 +33,7 @@ std::vector<std::set<std::uint32_t>> brute_force_neighbours(const infolerp::inde
   return out;
 }
 void check_against_brute_force(const infolerp::indexed_mesh& m) {
-  auto topo = infolerp::build_topology(m);
+  auto topo = infolerp::make_topology(m);
   REQUIRE(topo.ok());
   const auto ref = brute_force_neighbours(m);
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
@@ -46,14 +46,14 @@ void check_against_brute_force(const infolerp::indexed_mesh& m) {
 
 TEST_CASE("closed meshes: every edge has two triangles, Euler characteristic holds") {
   const auto sphere = infolerp::support::make_icosphere(3);
-  auto topo = infolerp::build_topology(sphere);
+  auto topo = infolerp::make_topology(sphere);
   REQUIRE(topo.ok());
   CHECK(topo->edge_count() == 3 * sphere.triangles.size() / 2);
   CHECK(sphere.positions.size() + sphere.triangles.size() - topo->edge_count() == 2);  // V - E + F = 2
   CHECK(infolerp::boundary_edges(*topo).empty());
   for (std::size_t t = 0; t < sphere.triangles.size(); ++t) CHECK(topo->neighbours_of(t).size() == 3);
   const auto torus = infolerp::support::make_torus(24, 12, 1.0f, 0.3f);
-  auto tt = infolerp::build_topology(torus);
+  auto tt = infolerp::make_topology(torus);
   REQUIRE(tt.ok());
   CHECK(torus.positions.size() + torus.triangles.size() - tt->edge_count() == 0);  // genus 1
 }
@@ -61,7 +61,7 @@ TEST_CASE("closed meshes: every edge has two triangles, Euler characteristic hol
 TEST_CASE("dual graph matches brute force, including boundaries") {
   check_against_brute_force(infolerp::support::make_icosphere(2));
   check_against_brute_force(infolerp::support::make_plane(7, 5, 1.0f));
-  auto plane = infolerp::build_topology(infolerp::support::make_plane(7, 5, 1.0f));
+  auto plane = infolerp::make_topology(infolerp::support::make_plane(7, 5, 1.0f));
   REQUIRE(plane.ok());
   CHECK(infolerp::boundary_edges(*plane).size() == 2 * (7 + 5));
 }
@@ -70,7 +70,7 @@ TEST_CASE("non-manifold edges keep every triangle on them adjacent") {
   infolerp::indexed_mesh fan;
   fan.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
   fan.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // edge (0,1) has three triangles
-  auto topo = infolerp::build_topology(fan);
+  auto topo = infolerp::make_topology(fan);
   REQUIRE(topo.ok());
   std::size_t non_manifold = 0;
   for (std::size_t e = 0; e < topo->edge_count(); ++e) non_manifold += topo->is_non_manifold_edge(e);
@@ -83,7 +83,7 @@ TEST_CASE("degenerate and bad triangles") {
   infolerp::indexed_mesh m;
   m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   m.triangles = {{0, 1, 2}, {0, 0, 1}};  // a repeated index: edge (0,0) is left out
-  auto topo = infolerp::build_topology(m);
+  auto topo = infolerp::make_topology(m);
   REQUIRE(topo.ok());
   CHECK(topo->triangle_edges[3 * 1 + 0] == infolerp::invalid_id);
   CHECK(topo->neighbours_of(1).size() == 1);
@@ -94,12 +94,12 @@ TEST_CASE("degenerate and bad triangles") {
   CHECK(std::vector<std::uint32_t>(faces.begin(), faces.end()) == std::vector<std::uint32_t>{0, 1});
   CHECK_FALSE(topo->is_non_manifold_edge(e01));
   m.triangles.push_back({0, 1, 3});
-  auto bad = infolerp::build_topology(m);
+  auto bad = infolerp::make_topology(m);
   REQUIRE_FALSE(bad.ok());
   CHECK(bad.error().code() == infolerp::errc::index_out_of_range);
   CHECK(bad.error().element() == 2);
   CHECK(bad.error().message().find("triangle 2 corner 2: vertex index 3 out of range") != std::string::npos);
-  auto empty = infolerp::build_topology(infolerp::indexed_mesh{});
+  auto empty = infolerp::make_topology(infolerp::indexed_mesh{});
   REQUIRE(empty.ok());
   CHECK(empty->triangle_count() == 0);
 }
@@ -107,7 +107,7 @@ TEST_CASE("degenerate and bad triangles") {
 TEST_CASE("connected components") {
   infolerp::indexed_mesh two = infolerp::support::make_icosphere(1);
   infolerp::support::append(two, infolerp::support::make_box({3, 3, 3}, {4, 4, 4}));
-  auto topo = infolerp::build_topology(two);
+  auto topo = infolerp::make_topology(two);
   REQUIRE(topo.ok());
   const auto comps = infolerp::connected_components(*topo);
   CHECK(comps.count == 2);
@@ -119,7 +119,7 @@ TEST_CASE("real meshes from CGAL data: edge and face lists agree") {
   for (const char* name : {"fandisk", "bunny00"}) {
     auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh(name));
     REQUIRE(m.ok());
-    auto topo = infolerp::build_topology(*m);
+    auto topo = infolerp::make_topology(*m);
     REQUIRE(topo.ok());
     // Every edge's faces list that triangle's edge back.
     for (std::size_t e = 0; e < topo->edge_count(); ++e)
@@ -140,7 +140,7 @@ TEST_CASE("Morton order is a permutation that brings dual-graph neighbours close
   std::shuffle(m.triangles.begin(), m.triangles.end(), rng);  // a mesh file in no spatial order
   // Mean |index distance| between dual-graph neighbours.
   auto spread = [](const infolerp::indexed_mesh& mesh) {
-    auto topo = infolerp::build_topology(mesh);
+    auto topo = infolerp::make_topology(mesh);
     REQUIRE(topo.ok());
     double sum = 0.0, pairs = 0.0;
     for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)

@@ -42,7 +42,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   FUZZ_CHECK(next == c->cluster_count);
   // Every cluster is one edge-connected piece.
-  auto topo = infolerp::build_topology(m);
+  auto topo = infolerp::make_topology(m);
   FUZZ_CHECK(topo.ok());
   std::vector<char> seen(nt, 0), cluster_seen(c->cluster_count, 0);
   std::vector<std::uint32_t> stack;

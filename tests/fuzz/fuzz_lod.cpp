@@ -46,7 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (auto& c : cluster) c = r.u8() % (clusters + ((flags & 1) ? 1u : 0u));  // flag 1: ids may be out of range
   std::vector<double> w(3 * m.triangles.size() + ((flags & 2) ? 1u : 0u));   // flag 2: one weight too many
   for (auto& x : w) x = (flags & 4) ? 1.0 : r.unit() * 8.0;                   // flag 4: uniform weights
-  auto h = infolerp::build_contraction_hierarchy(m, w, cluster, clusters,
+  auto h = infolerp::make_contraction_hierarchy(m, w, cluster, clusters,
                                                   {.backstop = backstop, .cluster_local_first = (flags & 8) == 0});
   fuzz::check_error(h.error());
   if (!h.ok()) return 0;

@@ -1,6 +1,6 @@
 // libFuzzer target: mesh validation, topology and the strided view on arbitrary small meshes.
 // Input: [flags][mesh (fuzz_common.hpp)]. Checks that nothing reads out of bounds (ASan), that
-// validate_mesh, build_topology and the strided view agree on index errors, the topology's
+// validate_mesh, make_topology and the strided view agree on index errors, the topology's
 // invariants, and that a mesh validate_mesh accepts gives finite geometry and curvature.
 #include <algorithm>
 #include <cmath>
@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bool in_range = fuzz::indices_in_range(m);
   if (nv > 0 && nt > 0) FUZZ_CHECK(in_range == (v.code() != infolerp::errc::index_out_of_range));
 
-  auto topo = infolerp::build_topology(m);
+  auto topo = infolerp::make_topology(m);
   fuzz::check_error(topo.error());
   FUZZ_CHECK(topo.ok() == in_range);
   if (topo.ok()) {

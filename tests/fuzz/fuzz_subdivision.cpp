@@ -41,7 +41,7 @@ void check_conforming(const infolerp::subdivision_mesh& s) {
   FUZZ_CHECK(leaves == s.leaf_count());
   const infolerp::indexed_mesh lm = s.leaf_mesh();
   FUZZ_CHECK(lm.triangles.size() == leaves);
-  auto topo = infolerp::build_topology(lm);
+  auto topo = infolerp::make_topology(lm);
   FUZZ_CHECK(topo.ok());
   for (std::size_t e = 0; e < topo->edge_count(); ++e) FUZZ_CHECK(topo->edge_valence(e) <= 2);
   for (const auto& t : lm.triangles)  // unused input vertices may hold anything

@@ -75,7 +75,7 @@ std::vector<std::uint32_t> reference_indices(const contraction_hierarchy& h, std
 result<contraction_hierarchy> uniform_hierarchy(const indexed_mesh& m, std::span<const std::uint32_t> cl,
                                                 std::uint32_t count, double backstop) {
   std::vector<double> w(3 * m.triangle_count(), 1.0);
-  return build_contraction_hierarchy(m, w, cl, count, {.backstop = backstop});
+  return make_contraction_hierarchy(m, w, cl, count, {.backstop = backstop});
 }
 
 }  // namespace
@@ -282,7 +282,7 @@ TEST_CASE("hierarchy on a bumpy plane with holes: no flip, boundary kept, manifo
   const std::vector<std::uint32_t> cl(m.triangle_count(), 0);
   const std::vector<double> w(3 * m.triangle_count(), 1.0);
   // No boundary planes: only the boundary rule keeps the rim.
-  auto h = build_contraction_hierarchy(m, w, cl, 1, {.backstop = 0.0, .boundary_weight = 0.0});
+  auto h = make_contraction_hierarchy(m, w, cl, 1, {.backstop = 0.0, .boundary_weight = 0.0});
   REQUIRE(h.ok());
   REQUIRE(h->contraction_count() > m.vertex_count() / 2);
   // Replay the contractions one by one on a vertex map.
@@ -324,12 +324,12 @@ TEST_CASE("hierarchy: a non-manifold edge is refused and named", "[lod]") {
   m.triangles = {{5, 2, 4}, {0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // edge (0, 1) has three triangles
   const std::vector<double> w(3 * m.triangle_count(), 1.0);
   const std::vector<std::uint32_t> cl(m.triangle_count(), 0);
-  auto h = build_contraction_hierarchy(m, w, cl, 1);
+  auto h = make_contraction_hierarchy(m, w, cl, 1);
   REQUIRE(!h.ok());
   CHECK(h.error().code() == errc::non_manifold_edge);
   CHECK(h.error().element() == 0);
   m.triangles.pop_back();
-  CHECK(build_contraction_hierarchy(m, std::span(w).first(9), std::span(cl).first(3), 1).ok());
+  CHECK(make_contraction_hierarchy(m, std::span(w).first(9), std::span(cl).first(3), 1).ok());
 }
 
 TEST_CASE("vertex contraction: identical bits for any executor", "[lod]") {
@@ -358,7 +358,7 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 1.0 + 0.5 * std::sin(3.0 * m.positions[v].x);
   auto wm = weighting_map(m, sal, cl, 8);
   REQUIRE(wm.ok());
-  auto h = build_contraction_hierarchy(m, *wm, cl, 8);
+  auto h = make_contraction_hierarchy(m, *wm, cl, 8);
   REQUIRE(h.ok());
   auto table = compute_cluster_attributes(m, sal, cl, 8);
   REQUIRE(table.ok());
@@ -413,11 +413,11 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   CHECK(s.element() == 3);
   std::vector<double> w(3 * m.triangle_count(), 1.0);
   w[5] = -1.0;
-  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().code() == errc::non_finite);
+  CHECK(make_contraction_hierarchy(m, w, cl, 8).error().code() == errc::non_finite);
   w[5] = std::nan("");
-  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().element() == 5);
+  CHECK(make_contraction_hierarchy(m, w, cl, 8).error().element() == 5);
   w.pop_back();
-  CHECK(build_contraction_hierarchy(m, w, cl, 8).error().code() == errc::bad_size);
+  CHECK(make_contraction_hierarchy(m, w, cl, 8).error().code() == errc::bad_size);
   std::vector<double> bad_sal = sal;
   bad_sal[2] = -0.5;
   CHECK(weighting_map(m, bad_sal, cl, 8).error().code() == errc::non_finite);
@@ -434,7 +434,7 @@ TEST_CASE("real meshes: hierarchy to the backstop stays manifold", "[lod][real]"
     REQUIRE(clusters.ok());
     auto wm = weighting_map(*m, sal->saliency, clusters->cluster, clusters->count);
     REQUIRE(wm.ok());
-    auto h = build_contraction_hierarchy(*m, *wm, clusters->cluster, clusters->count);
+    auto h = make_contraction_hierarchy(*m, *wm, clusters->cluster, clusters->count);
     REQUIRE(h.ok());
     INFO(name << ": " << h->contraction_count() << " contractions of " << m->vertex_count() << " vertices");
     CHECK(h->contraction_count() + static_cast<std::size_t>(0.02 * static_cast<double>(m->vertex_count())) >= m->vertex_count());

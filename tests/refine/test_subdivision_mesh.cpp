@@ -158,7 +158,7 @@ void check_invariants(const subdivision_mesh& s, const indexed_mesh& input) {
       leaf_vertices.insert(n.vertices[k]);
     }
   }
-  auto in_topo = infolerp::build_topology(input);
+  auto in_topo = infolerp::make_topology(input);
   VERIFY(in_topo.ok());
   double input_boundary = 0.0, leaf_boundary = 0.0;
   for (std::uint32_t e : infolerp::boundary_edges(*in_topo))

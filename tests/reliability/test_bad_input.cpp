@@ -108,7 +108,7 @@ enum mesh_entry : std::size_t {
   e_cluster_attributes, e_cluster_localized, e_subdivision_build, e_cluster_mesh, mesh_entry_count
 };
 const char* const mesh_entry_names[mesh_entry_count] = {
-    "validate_mesh", "build_topology", "mean_curvature", "compute_saliency",
+    "validate_mesh", "make_topology", "mean_curvature", "compute_saliency",
     "salient_clustering", "compute_cluster_attributes", "cluster_localized_saliency", "subdivision_mesh::create",
     "cluster_mesh(visibility+orientation+stretch)"};
 
@@ -244,7 +244,7 @@ std::pair<status, bool> run_mesh_entry(mesh_entry e, const indexed_mesh& m) {
   switch (e) {
     case e_validate: return {infolerp::validate_mesh(m), true};
     case e_topology: {
-      auto r = infolerp::build_topology(m);
+      auto r = infolerp::make_topology(m);
       return {status_of(r), !r.ok() || r->triangle_count() == nt};
     }
     case e_curvature: {
@@ -358,7 +358,7 @@ TEST_CASE("bad-input matrix: raw index buffers (strided view)", "[reliability][b
   REQUIRE(v.ok());
   check_cell("index out of range", "validate_mesh(strided)", infolerp::validate_mesh(*v),
              {errc::index_out_of_range, "triangle 1 corner 1"});
-  check_cell("index out of range", "build_topology(strided)", status_of(infolerp::build_topology(*v)),
+  check_cell("index out of range", "make_topology(strided)", status_of(infolerp::make_topology(*v)),
              {errc::index_out_of_range, "triangle 1"});
   auto good = infolerp::make_strided_mesh_view(pos, 4, 16, idx, 6);
   REQUIRE(good.ok());

@@ -72,7 +72,7 @@ auto with_every_executor(F&& f) {
 
 TEST_CASE("determinism: topology and curvature across repeated runs", "[reliability][determinism][threads]") {
   const indexed_mesh m = bumpy_sphere(3);
-  const auto a = infolerp::build_topology(m), b = infolerp::build_topology(m);
+  const auto a = infolerp::make_topology(m), b = infolerp::make_topology(m);
   REQUIRE(a.ok());
   REQUIRE(b.ok());
   CHECK(same_bits(a->edges, b->edges));

@@ -227,7 +227,7 @@ TEST_CASE("stress: slivers with angles near 0 and 180 degrees", "[reliability][s
     REQUIRE(sub->split(first).ok());
     for (const auto& p : sub->positions()) CHECK((std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)));
     const auto leaves = sub->leaf_mesh();
-    auto topo = infolerp::build_topology(leaves);
+    auto topo = infolerp::make_topology(leaves);
     REQUIRE(topo.ok());
     for (std::size_t e = 0; e < topo->edge_count(); ++e) CHECK(topo->edge_valence(e) <= 2);
     const auto loc = sub->locate(first, {0.4f, 0.3f});
@@ -256,7 +256,7 @@ TEST_CASE("stress: 300 nested selections (deeper than the 255 levels a triangle 
     deepest = std::max<int>(deepest, n.level);
   }
   CHECK(deepest == 255);
-  const auto topo = infolerp::build_topology(s->leaf_mesh());
+  const auto topo = infolerp::make_topology(s->leaf_mesh());
   REQUIRE(topo.ok());
   for (std::size_t e = 0; e < topo->edge_count(); ++e) CHECK(topo->edge_valence(e) <= 2);
   const auto loc = s->locate(0, {0.3f, 0.3f});

@@ -53,7 +53,7 @@ reference brute_force(const infolerp::indexed_mesh& m, const infolerp::saliency_
   double mean_abs = 0.0;
   for (double x : c) mean_abs += std::abs(x);
   mean_abs /= static_cast<double>(n);
-  const auto topo = *infolerp::build_topology(m);
+  const auto topo = *infolerp::make_topology(m);
   reference ref;
   ref.saliency.assign(n, 0.0);
   for (double s : opt.scales) {

@@ -28,7 +28,7 @@ infolerp::indexed_mesh bumpy_sphere() {
 // Number of connected pieces of each cluster in the dual graph.
 std::vector<int> pieces_per_cluster(const infolerp::indexed_mesh& m, const std::vector<std::uint32_t>& label,
                                     std::uint32_t count) {
-  const auto topo = *infolerp::build_topology(m);
+  const auto topo = *infolerp::make_topology(m);
   std::vector<int> pieces(count, 0);
   std::vector<bool> seen(label.size(), false);
   for (std::size_t f = 0; f < label.size(); ++f) {
@@ -137,7 +137,7 @@ TEST_CASE("salient clustering: re-seeding gives distinct seeds when thin cluster
   std::vector<double> sal(m.positions.size());
   for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 0.1 + 0.01 * static_cast<double>(v);
   sal[4] = 1.0;
-  const auto topo = *infolerp::build_topology(m);
+  const auto topo = *infolerp::make_topology(m);
   const auto fd = infolerp::detail::make_face_data(m, topo, sal);
   std::vector<std::uint32_t> label(m.triangles.size());
   for (std::size_t i = 0; i < label.size(); ++i) {

@@ -202,7 +202,7 @@ result<mesh_clustering> cluster_mesh(const M& m, const T& tracer, E&& exec, cons
                 "infolerp: each channel needs a `threshold` and init(span<const uint32_t>) -> result<channel_state>, "
                 "or prepare(mesh, topology, tracer, executor) (see cluster/channel.hpp)");
   if (status st = detail::check_inputs<M, E>(m, opts, channels...); !st) return st;
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   if (!topo) return topo.error();
   mesh_clustering out;
   out.cluster_of.assign(mesh_triangle_count(m), 0);
@@ -250,7 +250,7 @@ result<mesh_clustering> cluster_keyframes(const M& m, F&& tracer_of, E&& exec, c
     if (const std::size_t n = mesh_keyframe_vertex_count(m, k); n != mesh_vertex_count(m))
       return make_error(errc::bad_size, k, "cluster_keyframes: keyframe ", k, " has ", n, " positions for ",
                         mesh_vertex_count(m), " vertices");
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   if (!topo) return topo.error();
   mesh_clustering out;
   out.cluster_of.assign(mesh_triangle_count(m), 0);

@@ -137,7 +137,7 @@ result<seam_clustering> split_at_uv_seams(const M& m, std::span<const std::uint3
           return make_error(errc::non_finite, t, "split_at_uv_seams: triangle ", t, " corner ", c, " has a non-finite texcoord");
 
   const detail::welded_triangles welded = detail::weld_by_position(m);
-  auto topo = build_topology(welded);
+  auto topo = make_topology(welded);
   if (!topo) return topo.error();
 
   // Step 1: the joined dual graph (CSR) and the seam edges.

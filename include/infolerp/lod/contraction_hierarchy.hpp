@@ -306,7 +306,7 @@ class collapse_mesh {
 // a cluster id out of range (names the triangle), options outside their ranges.
 // Serial (the global order is inherently sequential); pure.
 template <class M>
-result<contraction_hierarchy> build_contraction_hierarchy(const M& m, std::span<const double> weights,
+result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<const double> weights,
                                                           std::span<const std::uint32_t> cluster,
                                                           std::uint32_t cluster_count,
                                                           const simplification_options& opt = {}) {

@@ -50,7 +50,7 @@ struct mesh_topology {
 // Allocation: the result, about 60 bytes per triangle, and temporaries freed on return (48
 // bytes per triangle plus 4 per vertex).
 template <class M>
-result<mesh_topology> build_topology(const M& m) {
+result<mesh_topology> make_topology(const M& m) {
   static_assert(check_mesh<M>());
   const std::size_t nv = mesh_vertex_count(m);
   const std::size_t nt = mesh_triangle_count(m);

@@ -1,7 +1,7 @@
 #pragma once
 // Mesh validation: the checks every infolerp entry point relies on (DESIGN.md, "Errors"),
 // reported with the offending index so that an engine can point at the bad triangle.
-// Non-manifold edges are found with build_topology (mesh/topology.hpp), not re-derived here.
+// Non-manifold edges are found with make_topology (mesh/topology.hpp), not re-derived here.
 //
 // Checks, in this order (the first failure is returned):
 //   1. empty mesh                     errc::empty_input          element() = no_element
@@ -80,7 +80,7 @@ status validate_mesh(const M& m, const validate_options& options = {}) {
   }
 
   if (!options.allow_non_manifold) {
-    auto topo = build_topology(m);
+    auto topo = make_topology(m);
     if (!topo) return topo.error();
     for (std::size_t e = 0; e < topo->edge_count(); ++e) {
       if (!topo->is_non_manifold_edge(e)) continue;

@@ -126,7 +126,7 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   double mean_abs_c = 0.0;
   for (std::size_t k = 0; k < P; ++k) mean_abs_c += std::abs(grid.value[k]);
   mean_abs_c /= static_cast<double>(P);
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   if (!topo.ok()) return topo.error();
   out.saliency.assign(nv, 0.0);
   out.levels.assign(opt.scales.size(), std::vector<double>(nv, 0.0));

@@ -357,7 +357,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     return make_error(errc::bad_parameter, no_element, "normal_weight ", opt.normal_weight, " must be >= 1");
   if (opt.clusters == 0 || opt.clusters > nt)
     return make_error(errc::bad_parameter, no_element, "clusters ", opt.clusters, " must be in [1, ", nt, "]");
-  auto topo = build_topology(m);
+  auto topo = make_topology(m);
   if (!topo.ok()) return topo.error();
 
   // Vertices used by triangles, most salient first (ties: lower index).
