@@ -140,6 +140,10 @@ struct display_delta {
 // executor). Accessors below are O(1) and allocate nothing.
 class progressive_refiner {
  public:
+  // Largest image a view may have (width · height): 2^25 pixels (8192 x 4096, above 8K UHD);
+  // the agent keeps about 60 bytes per pixel, so a view stays under 2 GB.
+  static constexpr std::size_t max_view_pixels = std::size_t{1} << 25;
+
   // Takes over a subdivision mesh (possibly already tessellated, §4.1 of the clustering paper);
   // start() returns to it, so a copy is kept. Errors: options out of range (names the member).
   // O(mesh) for the copy.
@@ -181,7 +185,7 @@ class progressive_refiner {
   // A new view: visibility recomputed, hierarchy and cache kept, requests issued for the newly
   // visible unshaded vertices, the criterion's per-view state (RND's draws) and the report
   // restarted. May be called at any time, with requests outstanding (they stay valid).
-  // Errors: an empty image; a camera with non-finite eye/target/up, eye == target, up parallel
+  // Errors: an empty image or one of more than max_view_pixels; a camera with non-finite eye/target/up, eye == target, up parallel
   // to the view direction or a field of view outside (0, 180); a hit naming a triangle the
   // mesh does not have or with a non-finite distance or barycentric (names the pixel). On error
   // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level);
@@ -213,9 +217,10 @@ class progressive_refiner {
     if (vertices.size() != colours.size())
       return make_error(errc::bad_size, no_element, "deliver: ", vertices.size(), " vertices but ", colours.size(), " colours");
     std::size_t bad = no_index;
+    bool named_twice = false;
     for (std::size_t i = 0; i < vertices.size() && bad == no_index; ++i) {
       const std::uint32_t v = vertices[i];
-      if (v >= vstate_.size() || vstate_[v] != requested) bad = i;
+      if (v >= vstate_.size() || vstate_[v] != requested) bad = i, named_twice = v < vstate_.size() && vstate_[v] == delivering;
       else vstate_[v] = delivering;
     }
     for (std::size_t i = 0; i < vertices.size(); ++i)  // undo the marks (duplicates stay detectable above)
@@ -225,6 +230,9 @@ class progressive_refiner {
       if (v >= vstate_.size())
         return make_error(errc::index_out_of_range, bad, "deliver: entry ", bad, ": vertex ", v, " out of range (",
                           vstate_.size(), " vertices)");
+      if (named_twice)
+        return make_error(errc::bad_parameter, bad, "deliver: entry ", bad, ": vertex ", v, " is named twice (first at entry ",
+                          std::find(vertices.begin(), vertices.end(), v) - vertices.begin(), ")");
       return make_error(errc::bad_parameter, bad, "deliver: entry ", bad, ": vertex ", v,
                         vstate_[v] == shaded ? " was already delivered" : " has no outstanding request");
     }
@@ -396,8 +404,11 @@ class progressive_refiner {
   template <class Camera>
   static status check_camera(const Camera& camera) {
     const std::uint32_t width = camera.width, height = camera.height;
-    if (std::size_t(width) * height == 0)
-      return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
+    const std::uint64_t pixels = std::uint64_t(width) * height;
+    if (pixels == 0) return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
+    if (pixels > max_view_pixels)
+      return make_error(errc::bad_parameter, no_element, "camera image ", width, "x", height, " has ", pixels,
+                        " pixels, more than max_view_pixels (", max_view_pixels, ")");
     if constexpr (requires { camera.eye; camera.target; camera.up; camera.vertical_fov_degrees; }) {
       const glm::vec3 e = camera.eye, t = camera.target, u = camera.up;
       for (int k = 0; k < 3; ++k)
