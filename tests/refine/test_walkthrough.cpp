@@ -432,3 +432,36 @@ TEST_CASE("walkthrough: the 120-frame path gives the same samples, deltas and im
   CHECK(walk_fingerprint(refinement_criterion::nld_os, true) == 0xa6997f7302c5a153ull);
   CHECK(walk_fingerprint(refinement_criterion::rnd, false) == 0x0c23c5cd7ee8a551ull);
 }
+
+TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the current view") {
+  serial_executor ex;
+  auto r = make_agent();
+  display_delta delta;
+  std::size_t sent = 0;
+  const auto take = [&] {
+    r.take_delta(delta);
+    sent += delta.added_from_cache.size() + delta.newly_shaded.size();
+  };
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    const pinhole_camera cam = support::walkthrough_path(f, FRAMES, W, H);
+    REQUIRE((f == 0 ? r.start(scene(), cam, ex) : r.set_view(scene(), cam, ex)).ok());
+    sent = 0;
+    take();
+    for (;;) {
+      std::vector<shading_point> req;
+      r.take_requests(req);
+      std::vector<std::uint32_t> ids;
+      std::vector<glm::vec3> colours;
+      for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
+      REQUIRE(r.deliver(ids, colours).ok());
+      take();
+      if (r.refine({}, ex) != refine_progress::refined) break;
+      take();
+    }
+    INFO("frame " << f);
+    if (f == 0) CHECK(r.report().stage1.triangles_total == r.report().stage1.triangles);  // all sent at once
+    CHECK(r.report().stage2.triangles_total == sent);
+  }
+  // A revisited view sends only what changed: the last frame is the first one's camera.
+  CHECK(r.report().stage2.triangles_total < r.report().stage2.triangles);
+}

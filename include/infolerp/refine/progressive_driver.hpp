@@ -9,7 +9,7 @@
 // without tracing. Hierarchy and cache survive view changes; only leaves shown now are refined,
 // requested or displayed. start() is a full restart.
 // Cache: one colour per hierarchy vertex (object space, the paper's Lambertian restriction),
-// 20 bytes per vertex plus 32 per hierarchy triangle. With max_cached_samples, vertices outside
+// 20 bytes per vertex plus 40 per hierarchy triangle. With max_cached_samples, vertices outside
 // the view are evicted least recently visible first; the current view's are never evicted, and
 // refinement stops (cache_full) once they alone reach the bound.
 // Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
@@ -25,7 +25,11 @@
 // take_delta() gives the changes in the paper's order: added from the cache, deleted, newly shaded.
 // Figures: stage 1 shades every visible leaf's vertices; stage 2 runs batches (criteria.hpp)
 // until the criterion selects nothing, the budget is reached (checked per batch) or max_batches
-// ran. Δ: leaves shown now; Δ_total: triangles ever shown since start().
+// ran. Δ: triangles shown now; Δ_total: triangles sent to the visualizer since the view was set
+// (those that entered the shown set; a new view sends only what the previous one did not show).
+// Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split
+// and the visible set, never the whole image or the hierarchy outside the view; the luminance
+// image and L_max follow the leaves whose shown triangle changed.
 //
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
@@ -188,8 +192,8 @@ class progressive_refiner {
   // Errors: an empty image or one of more than max_view_pixels; a camera with non-finite eye/target/up, eye == target, up parallel
   // to the view direction or a field of view outside (0, 180); a hit naming a triangle the
   // mesh does not have or with a non-finite distance or barycentric (names the pixel). On error
-  // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level);
-  // allocation O(pixels + triangles + vertices).
+  // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level), not
+  // the hierarchy's size; allocation O(pixels), per-triangle arrays grow with the hierarchy.
   template <class T, class Camera, class E = serial_executor>
   status set_view(const T& tracer, const Camera& camera, E&& exec = E{}) {
     return view(tracer, camera, exec, false);
@@ -211,8 +215,8 @@ class progressive_refiner {
   // Accepts the colours of requested vertices, in any order and any grouping. Errors: sizes
   // differ; a vertex out of range, never requested, already delivered, or named twice; a
   // non-finite colour (names the entry). On error nothing is stored.
-  // Complexity O(n + visible · level) (the shown set is brought up to date), plus
-  // O(V log V) when the cache bound evicts; allocation: the eviction's candidate list.
+  // Complexity O(n + in-view triangles) (the shown set is brought up to date), plus O(V) when
+  // the cache bound evicts (once per bound/8 deliveries); allocation: the eviction's candidates.
   status deliver(std::span<const std::uint32_t> vertices, std::span<const glm::vec3> colours) {
     if (vertices.size() != colours.size())
       return make_error(errc::bad_size, no_element, "deliver: ", vertices.size(), " vertices but ", colours.size(), " colours");
@@ -281,7 +285,8 @@ class progressive_refiner {
   // needs every earlier request delivered, so without a renderer behind the call (this
   // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
   // Preconditions: a view was set. Complexity per batch: the criterion's selection
-  // (criteria.hpp) + O(R) splits + O(pixels) re-location + O(visible · level).
+  // (criteria.hpp) + O(R) splits + O(visible + in-view triangles) + O(pixels of the split leaves
+  // · level) for the re-location + O(pixels whose shown triangle changed · log pixels).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
@@ -471,8 +476,13 @@ class progressive_refiner {
     state_.rng = splitmix64{options_.criteria.seed};
     pixel_luminance_.clear();
     in_view_.clear();
-    ever_shown_.clear();
-    ever_shown_count_ = 0;
+    visible_.clear();
+    leaf_pixels_.clear();
+    leaf_head_.clear();
+    display_of_.clear();
+    dirty_.clear();
+    dirty_mark_.clear();
+    dirty_clock_ = 1;
     vstate_.clear();
     colour_.clear();
     luminance_.clear();
@@ -513,7 +523,8 @@ class progressive_refiner {
     state_.points_drawn = 0;
     state_.exhausted = false;
     report_ = {};
-    update_view(exec);
+    sent_total_ = 0;
+    view_leaves(exec);
   }
 
   [[nodiscard]] bool done() const {
@@ -555,7 +566,7 @@ class progressive_refiner {
       }
       ++report_.batches;
       report_.selections += selected_.size();
-      update_view(exec);
+      follow_splits();
       render(exec);
       report_.stage2 = figures();
     }
@@ -590,17 +601,40 @@ class progressive_refiner {
   [[nodiscard]] stage_figures figures() const {
     stage_figures s;
     s.triangles = visible_.size();
-    s.triangles_total = ever_shown_count_;
+    s.triangles_total = sent_total_;
     s.triangles_produced = mesh_.triangle_count();
     s.shading_samples = samples_;
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
     return s;
   }
 
-  // Pixels whose leaf was split follow it down; projected areas, the visible set, the in-view
-  // marks, the requests and the shown set are brought up to date.
+  void grow() {
+    const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
+    leaf_pixels_.resize(nt, 0);
+    leaf_head_.resize(nt, invalid_id);
+    in_view_.resize(nt, 0);
+    display_of_.resize(nt, invalid_id);
+    dirty_mark_.resize(nt, 0);
+    vstate_.resize(nv, unshaded);
+    colour_.resize(nv, glm::vec3(0.0f));
+    luminance_.resize(nv, 0.0f);
+    last_seen_.resize(nv, 0);
+    delivered_epoch_.resize(nv, 0);
+  }
+
+  // Puts pixel p on its leaf's list; a leaf's first pixel makes it visible (fresh_).
+  void add_pixel(std::uint32_t p, std::uint32_t leaf) {
+    pixel_next_[p] = leaf_head_[leaf];
+    leaf_head_[leaf] = p;
+    if (leaf_pixels_[leaf]++ == 0) fresh_.push_back(leaf);
+  }
+
+  // A new view: every pixel is located from its hit's original triangle and listed under its
+  // leaf; the previous view's lists are dropped through its visible leaves, so the hierarchy
+  // outside both views costs nothing. O(pixels · level + previous visible).
   template <class E>
-  void update_view(E&& exec) {
+  void view_leaves(E&& exec) {
+    for (std::uint32_t t : visible_) leaf_pixels_[t] = 0, leaf_head_[t] = invalid_id;
     const std::size_t n = pixel_leaf_.size();
     exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) {
@@ -611,27 +645,59 @@ class progressive_refiner {
         pixel_weights_[p] = loc.weights;
       }
     });
-    const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
-    leaf_pixels_.assign(nt, 0);
-    ever_shown_.resize(nt, 0);
-    in_view_.resize(nt, 0);
-    display_of_.resize(nt, invalid_id);
-    vstate_.resize(nv, unshaded);
-    colour_.resize(nv, glm::vec3(0.0f));
-    luminance_.resize(nv, 0.0f);
-    last_seen_.resize(nv, 0);
-    delivered_epoch_.resize(nv, 0);
-    for (std::uint32_t leaf : pixel_leaf_)
-      if (leaf != invalid_id) ++leaf_pixels_[leaf];
-    visible_.clear();  // ascending by a scan: cheaper than sorting the leaves as found
-    for (std::uint32_t t = 0; t < nt; ++t)
-      if (leaf_pixels_[t] != 0) visible_.push_back(t);
-    for (std::uint32_t t : visible_)
-      if (!ever_shown_[t]) ever_shown_[t] = 1, ++ever_shown_count_;
-    // In view: the visible leaves and their ancestors; their corners are stamped and requested.
+    grow();
+    pixel_next_.resize(n);
+    fresh_.clear();
+    for (std::size_t p = 0; p < n; ++p)
+      if (pixel_leaf_[p] != invalid_id) add_pixel(static_cast<std::uint32_t>(p), pixel_leaf_[p]);
+    std::sort(fresh_.begin(), fresh_.end());
+    visible_.swap(fresh_);
     ++clock_;
     in_view_vertices_ = 0;
-    for (std::uint32_t leaf : visible_)
+    all_dirty_ = true;
+    stamp_in_view(visible_);
+    enforce_cache_bound();
+    update_display();
+  }
+
+  // After a batch's splits: only the pixels of the visible leaves that were split follow them
+  // down (pixel lists), the visible set loses those leaves and gains the children that cover
+  // pixels, and only the new leaves are walked up for the in-view marks and requests (the
+  // in-view set of a view only grows). O(visible + pixels of the split leaves · level).
+  void follow_splits() {
+    grow();
+    fresh_.clear();
+    for (std::uint32_t t : visible_) {
+      if (mesh_.is_leaf(t)) continue;
+      std::uint32_t p = leaf_head_[t];
+      leaf_head_[t] = invalid_id;
+      leaf_pixels_[t] = 0;
+      while (p != invalid_id) {
+        const std::uint32_t next = pixel_next_[p];
+        const point_location loc = mesh_.locate_from(t, pixel_weights_[p]);
+        pixel_leaf_[p] = loc.leaf;
+        pixel_weights_[p] = loc.weights;
+        add_pixel(p, loc.leaf);
+        p = next;
+      }
+    }
+    if (fresh_.empty()) return;
+    std::sort(fresh_.begin(), fresh_.end());
+    for (std::uint32_t t : fresh_) mark_dirty(t);
+    visible_.erase(std::remove_if(visible_.begin(), visible_.end(), [&](std::uint32_t t) { return leaf_pixels_[t] == 0; }),
+                   visible_.end());
+    const auto middle = static_cast<std::ptrdiff_t>(visible_.size());
+    visible_.insert(visible_.end(), fresh_.begin(), fresh_.end());
+    std::inplace_merge(visible_.begin(), visible_.begin() + middle, visible_.end());
+    stamp_in_view(fresh_);
+    enforce_cache_bound();
+    update_display();
+  }
+
+  // In view: the given leaves and their ancestors up to the first already marked; their corners
+  // are stamped and requested.
+  void stamp_in_view(std::span<const std::uint32_t> leaves) {
+    for (std::uint32_t leaf : leaves)
       for (std::uint32_t t = leaf; t != invalid_id && in_view_[t] != clock_; t = mesh_.triangle(t).parent) {
         in_view_[t] = clock_;
         const glm::uvec3 v = mesh_.triangle(t).vertices;
@@ -641,8 +707,13 @@ class progressive_refiner {
           if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_, ++view_requests_;
         }
       }
-    enforce_cache_bound();
-    update_display();
+  }
+
+  // A leaf whose pixels' colours may have changed since the last luminance image.
+  void mark_dirty(std::uint32_t leaf) {
+    if (all_dirty_ || dirty_mark_[leaf] == dirty_clock_) return;
+    dirty_mark_[leaf] = dirty_clock_;
+    dirty_.push_back(leaf);
   }
 
   // The current view alone fills the cache: nothing is left to evict.
@@ -675,6 +746,7 @@ class progressive_refiner {
     decided_.resize(nt, 0);
     shown_mark_.resize(nt, 0);
     decision_.resize(nt);
+    previous_shown_.swap(shown_);
     shown_.clear();
     for (std::uint32_t leaf : visible_) {
       path_.clear();
@@ -689,22 +761,33 @@ class progressive_refiner {
         decided_[*it] = display_clock_;
         decision_[*it] = above;
       }
-      display_of_[leaf] = above.shown;
+      if (display_of_[leaf] != above.shown) display_of_[leaf] = above.shown, mark_dirty(leaf);
       if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
         shown_mark_[above.shown] = display_clock_, shown_.push_back(above.shown);
     }
     std::sort(shown_.begin(), shown_.end());
+    // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
+    std::size_t kept = 0;
+    for (std::size_t i = 0, j = 0; i < shown_.size() && j < previous_shown_.size();)
+      if (shown_[i] < previous_shown_[j]) ++i;
+      else if (previous_shown_[j] < shown_[i]) ++j;
+      else ++kept, ++i, ++j;
+    sent_total_ += shown_.size() - kept;
   }
 
-  // Least recently visible first (ties by id), never a vertex of the current view.
+  // Least recently visible first (ties by id), never a vertex of the current view. Past the bound
+  // the cache is brought down to its low-water mark, bound − bound/8, so the O(vertices) scan
+  // runs once per bound/8 deliveries, not on every one.
   void enforce_cache_bound() {
-    if (shaded_count_ <= options_.max_cached_samples) return;
+    const std::size_t bound = options_.max_cached_samples;
+    if (shaded_count_ <= bound) return;
     evict_.clear();
     for (std::uint32_t v = 0; v < vstate_.size(); ++v)
       if (vstate_[v] == shaded && last_seen_[v] != clock_) evict_.push_back(v);
-    const std::size_t excess = std::min(shaded_count_ - options_.max_cached_samples, evict_.size());
-    std::partial_sort(evict_.begin(), evict_.begin() + std::ptrdiff_t(excess), evict_.end(),
-                      [&](std::uint32_t a, std::uint32_t b) { return last_seen_[a] != last_seen_[b] ? last_seen_[a] < last_seen_[b] : a < b; });
+    const std::size_t excess = std::min(shaded_count_ - (bound - bound / 8), evict_.size());
+    if (excess == 0) return;
+    std::nth_element(evict_.begin(), evict_.begin() + std::ptrdiff_t(excess - 1), evict_.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return last_seen_[a] != last_seen_[b] ? last_seen_[a] < last_seen_[b] : a < b; });
     for (std::size_t i = 0; i < excess; ++i) {
       const std::uint32_t v = evict_[i];
       vstate_[v] = unshaded;
@@ -727,15 +810,33 @@ class progressive_refiner {
     return sp;
   }
 
-  // The interpolated luminance per pixel and L_max, its maximum over the image (§4).
+  // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
+  // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
+  // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
+  // 1, pixel p at n + p). O(pixels) per view, O(dirty pixels · log pixels) per batch.
   template <class E>
   void luminance_image(E&& exec) {
-    pixel_luminance_.resize(pixel_leaf_.size());
-    exec.parallel_for(pixel_leaf_.size(), options_.grain, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t p = begin; p < end; ++p) pixel_luminance_[p] = luminance(pixel_colour(p));
-    });
-    l_max_ = 0.0f;
-    for (float l : pixel_luminance_) l_max_ = std::max(l_max_, l);
+    const std::size_t n = pixel_leaf_.size();
+    if (all_dirty_) {
+      pixel_luminance_.resize(n);
+      lum_tree_.resize(2 * n);
+      exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = pixel_luminance_[p] = luminance(pixel_colour(p));
+      });
+      for (std::size_t i = n; i-- > 1;) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+      all_dirty_ = false;
+    } else {
+      for (std::uint32_t leaf : dirty_)
+        for (std::uint32_t p = leaf_head_[leaf]; p != invalid_id; p = pixel_next_[p]) {
+          pixel_luminance_[p] = luminance(pixel_colour(p));
+          std::size_t i = n + p;
+          lum_tree_[i] = pixel_luminance_[p];
+          for (i /= 2; i >= 1; i /= 2) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+        }
+    }
+    dirty_.clear();
+    if (++dirty_clock_ == 0) std::fill(dirty_mark_.begin(), dirty_mark_.end(), 0u), dirty_clock_ = 1;
+    l_max_ = n == 0 ? 0.0f : std::max(0.0f, lum_tree_[1]);
   }
 
   subdivision_mesh initial_mesh_, mesh_;
@@ -758,8 +859,15 @@ class progressive_refiner {
   std::vector<display_step> decision_;
   std::vector<std::uint32_t> decided_, shown_mark_;
   std::uint32_t display_clock_ = 0;
-  std::vector<std::uint8_t> ever_shown_;
-  std::size_t ever_shown_count_ = 0;
+  std::vector<std::uint32_t> leaf_head_;   // per triangle: first pixel of its list (visible leaves), else invalid_id
+  std::vector<std::uint32_t> pixel_next_;  // per pixel: the next pixel of its leaf's list
+  std::vector<std::uint32_t> fresh_;       // leaves that gained their first pixel
+  std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
+  std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
+  std::uint32_t dirty_clock_ = 1;
+  bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
+  std::vector<std::uint32_t> previous_shown_;
+  std::size_t sent_total_ = 0;             // triangles that entered the shown set since the view was set
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
   std::vector<float> luminance_;
