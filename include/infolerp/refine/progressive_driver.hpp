@@ -747,7 +747,8 @@ class progressive_refiner {
     shown_mark_.resize(nt, 0);
     decision_.resize(nt);
     previous_shown_.swap(shown_);
-    shown_.clear();
+    shown_.clear();  // leaves shown themselves, ascending as visible_ is
+    shown_above_.clear();  // ancestors shown for their leaves, each once
     for (std::uint32_t leaf : visible_) {
       path_.clear();
       std::uint32_t t = leaf;
@@ -762,10 +763,16 @@ class progressive_refiner {
         decision_[*it] = above;
       }
       if (display_of_[leaf] != above.shown) display_of_[leaf] = above.shown, mark_dirty(leaf);
-      if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
-        shown_mark_[above.shown] = display_clock_, shown_.push_back(above.shown);
+      if (above.shown == leaf) shown_.push_back(leaf);
+      else if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
+        shown_mark_[above.shown] = display_clock_, shown_above_.push_back(above.shown);
     }
-    std::sort(shown_.begin(), shown_.end());
+    if (!shown_above_.empty()) {  // sorting only the ancestors: O(shown + ancestors · log)
+      std::sort(shown_above_.begin(), shown_above_.end());
+      merged_.resize(shown_.size() + shown_above_.size());
+      std::merge(shown_.begin(), shown_.end(), shown_above_.begin(), shown_above_.end(), merged_.begin());
+      shown_.swap(merged_);
+    }
     // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
     std::size_t kept = 0;
     for (std::size_t i = 0, j = 0; i < shown_.size() && j < previous_shown_.size();)
@@ -866,7 +873,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
-  std::vector<std::uint32_t> previous_shown_;
+  std::vector<std::uint32_t> previous_shown_, shown_above_, merged_;
   std::size_t sent_total_ = 0;             // triangles that entered the shown set since the view was set
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
