@@ -38,6 +38,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <span>
 #include <type_traits>
@@ -254,7 +255,9 @@ class progressive_refiner {
     samples_ += vertices.size();
     shaded_count_ += vertices.size();
     enforce_cache_bound();
-    update_display();
+    begin_display_update();
+    for (std::uint32_t v : vertices) seed_waiters(v);
+    finish_display_update();
     return {};
   }
 
@@ -483,6 +486,10 @@ class progressive_refiner {
     dirty_.clear();
     dirty_mark_.clear();
     dirty_clock_ = 1;
+    shown_count_.clear();
+    waiters_.clear();
+    waiter_head_.clear();
+    waiter_clock_.clear();
     vstate_.clear();
     colour_.clear();
     luminance_.clear();
@@ -615,6 +622,12 @@ class progressive_refiner {
     in_view_.resize(nt, 0);
     display_of_.resize(nt, invalid_id);
     dirty_mark_.resize(nt, 0);
+    shown_count_.resize(nt, 0);
+    decided_.resize(nt, 0);
+    shown_mark_.resize(nt, 0);
+    decision_.resize(nt);
+    waiter_head_.resize(nv, invalid_id);
+    waiter_clock_.resize(nv, 0);
     vstate_.resize(nv, unshaded);
     colour_.resize(nv, glm::vec3(0.0f));
     luminance_.resize(nv, 0.0f);
@@ -655,6 +668,7 @@ class progressive_refiner {
     ++clock_;
     in_view_vertices_ = 0;
     all_dirty_ = true;
+    waiters_.clear();
     stamp_in_view(visible_);
     enforce_cache_bound();
     update_display();
@@ -667,8 +681,11 @@ class progressive_refiner {
   void follow_splits() {
     grow();
     fresh_.clear();
+    begin_display_update();
     for (std::uint32_t t : visible_) {
       if (mesh_.is_leaf(t)) continue;
+      set_display(t, invalid_id);  // no longer a visible leaf
+      seeds_.push_back(mesh_.triangle(t).parent != invalid_id ? mesh_.triangle(t).parent : t);
       std::uint32_t p = leaf_head_[t];
       leaf_head_[t] = invalid_id;
       leaf_pixels_[t] = 0;
@@ -681,7 +698,7 @@ class progressive_refiner {
         p = next;
       }
     }
-    if (fresh_.empty()) return;
+    if (fresh_.empty()) return finish_display_update();
     std::sort(fresh_.begin(), fresh_.end());
     for (std::uint32_t t : fresh_) mark_dirty(t);
     visible_.erase(std::remove_if(visible_.begin(), visible_.end(), [&](std::uint32_t t) { return leaf_pixels_[t] == 0; }),
@@ -691,7 +708,7 @@ class progressive_refiner {
     std::inplace_merge(visible_.begin(), visible_.begin() + middle, visible_.end());
     stamp_in_view(fresh_);
     enforce_cache_bound();
-    update_display();
+    finish_display_update();
   }
 
   // In view: the given leaves and their ancestors up to the first already marked; their corners
@@ -705,8 +722,26 @@ class progressive_refiner {
           if (last_seen_[v[c]] != clock_) ++in_view_vertices_;
           last_seen_[v[c]] = clock_;
           if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_, ++view_requests_;
+          if (vstate_[v[c]] != shaded) add_waiter(v[c], t);
         }
       }
+  }
+
+  // Triangles of the view waiting for a vertex (one list per vertex, valid for clock_'s view).
+  void add_waiter(std::uint32_t v, std::uint32_t t) {
+    if (waiter_clock_[v] != clock_) waiter_clock_[v] = clock_, waiter_head_[v] = invalid_id;
+    waiters_.push_back({t, waiter_head_[v]});
+    waiter_head_[v] = static_cast<std::uint32_t>(waiters_.size() - 1);
+  }
+  // A delivered vertex: the shown cut may change under the parents of the triangles waiting for it
+  // (their readiness, and so their parents' expansion).
+  void seed_waiters(std::uint32_t v) {
+    if (waiter_clock_[v] != clock_) return;
+    for (std::uint32_t i = waiter_head_[v]; i != invalid_id; i = waiters_[i].next) {
+      const std::uint32_t t = waiters_[i].triangle, parent = mesh_.triangle(t).parent;
+      seeds_.push_back(parent != invalid_id ? parent : t);
+    }
+    waiter_head_[v] = invalid_id;
   }
 
   // A leaf whose pixels' colours may have changed since the last luminance image.
@@ -773,6 +808,9 @@ class progressive_refiner {
       std::merge(shown_.begin(), shown_.end(), shown_above_.begin(), shown_above_.end(), merged_.begin());
       shown_.swap(merged_);
     }
+    for (std::uint32_t t : previous_shown_) shown_count_[t] = 0;
+    for (std::uint32_t leaf : visible_)
+      if (display_of_[leaf] != invalid_id) ++shown_count_[display_of_[leaf]];
     // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
     std::size_t kept = 0;
     for (std::size_t i = 0, j = 0; i < shown_.size() && j < previous_shown_.size();)
@@ -780,6 +818,75 @@ class progressive_refiner {
       else if (previous_shown_[j] < shown_[i]) ++j;
       else ++kept, ++i, ++j;
     sent_total_ += shown_.size() - kept;
+  }
+
+  // The shown cut brought up to date under seed triangles only (split leaves' parents, parents of
+  // triangles that got a corner delivered): each in-view triangle's decision depends on its
+  // parent's, its own readiness and its in-view children's, so the seeds' in-view subtrees,
+  // parents first, are all that can change. The shown set follows per-triangle counts of the
+  // visible leaves showing it. O(seeded subtrees + shown); the same cut as update_display().
+  void begin_display_update() {
+    if (++display_clock_ == 0) {
+      std::fill(decided_.begin(), decided_.end(), 0u);
+      std::fill(shown_mark_.begin(), shown_mark_.end(), 0u);
+      display_clock_ = 1;
+    }
+    seeds_.clear();
+    touched_.clear();
+  }
+  void set_display(std::uint32_t leaf, std::uint32_t shown) {
+    const std::uint32_t old = display_of_[leaf];
+    if (old == shown) return;
+    if (old != invalid_id) touch(old), --shown_count_[old];
+    if (shown != invalid_id) touch(shown), ++shown_count_[shown];
+    display_of_[leaf] = shown;
+    mark_dirty(leaf);
+  }
+  void touch(std::uint32_t t) {
+    if (shown_mark_[t] == display_clock_) return;
+    shown_mark_[t] = display_clock_;
+    touched_.push_back({t, shown_count_[t] > 0});
+  }
+  void finish_display_update() {
+    std::sort(seeds_.begin(), seeds_.end(), [&](std::uint32_t a, std::uint32_t b) {
+      const auto la = mesh_.triangle(a).level, lb = mesh_.triangle(b).level;
+      return la != lb ? la < lb : a < b;
+    });
+    for (std::uint32_t s : seeds_) {
+      if (in_view_[s] != clock_ || decided_[s] == display_clock_) continue;
+      stack_.push_back(s);
+      while (!stack_.empty()) {
+        const std::uint32_t t = stack_.back();
+        stack_.pop_back();
+        decided_[t] = display_clock_;
+        const subdivision_triangle& n = mesh_.triangle(t);
+        display_step above = n.parent == invalid_id ? display_step{invalid_id, true} : decision_[n.parent];
+        const bool leaf = n.is_leaf();
+        if (above.open) {
+          if (!ready(t)) above.open = false;
+          else above = {t, !leaf && expands(t)};
+        }
+        decision_[t] = above;
+        if (leaf) set_display(t, above.shown);
+        for (std::uint32_t c = n.first_child; c < n.first_child + n.child_count; ++c)
+          if (in_view_[c] == clock_) stack_.push_back(c);
+      }
+    }
+    added_.clear();
+    removed_.clear();
+    for (const touched_triangle& x : touched_) {
+      const bool now = shown_count_[x.triangle] > 0;
+      if (now && !x.was) added_.push_back(x.triangle);
+      if (!now && x.was) removed_.push_back(x.triangle);
+    }
+    if (added_.empty() && removed_.empty()) return;
+    std::sort(added_.begin(), added_.end());
+    std::sort(removed_.begin(), removed_.end());
+    merged_.clear();
+    std::set_difference(shown_.begin(), shown_.end(), removed_.begin(), removed_.end(), std::back_inserter(merged_));
+    shown_.resize(merged_.size() + added_.size());
+    std::merge(merged_.begin(), merged_.end(), added_.begin(), added_.end(), shown_.begin());
+    sent_total_ += added_.size();
   }
 
   // Least recently visible first (ties by id), never a vertex of the current view. Past the bound
@@ -874,6 +981,18 @@ class progressive_refiner {
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
   std::vector<std::uint32_t> previous_shown_, shown_above_, merged_;
+  std::vector<std::uint32_t> shown_count_;  // per triangle: visible leaves showing it
+  struct waiter {
+    std::uint32_t triangle, next;
+  };
+  std::vector<waiter> waiters_;                            // the current view's waiting lists
+  std::vector<std::uint32_t> waiter_head_, waiter_clock_;  // per vertex: first waiter, its view's clock_
+  struct touched_triangle {
+    std::uint32_t triangle;
+    bool was;  // shown before this update
+  };
+  std::vector<touched_triangle> touched_;
+  std::vector<std::uint32_t> seeds_, stack_, added_, removed_;
   std::size_t sent_total_ = 0;             // triangles that entered the shown set since the view was set
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
