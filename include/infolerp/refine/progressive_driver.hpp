@@ -28,8 +28,9 @@
 // ran. Δ: triangles shown now; Δ_total: triangles sent to the visualizer since the view was set
 // (those that entered the shown set; a new view sends only what the previous one did not show).
 // Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split
-// and the visible set, never the whole image or the hierarchy outside the view; the luminance
-// image and L_max follow the leaves whose shown triangle changed.
+// and the visible set, never the whole image or the hierarchy outside the view; the shown cut is
+// recomputed only under what a batch split or a delivery made ready; the luminance image and
+// L_max follow the leaves whose shown triangle changed.
 //
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
@@ -216,7 +217,8 @@ class progressive_refiner {
   // Accepts the colours of requested vertices, in any order and any grouping. Errors: sizes
   // differ; a vertex out of range, never requested, already delivered, or named twice; a
   // non-finite colour (names the entry). On error nothing is stored.
-  // Complexity O(n + in-view triangles) (the shown set is brought up to date), plus O(V) when
+  // Complexity O(n + the in-view subtrees under the parents of the triangles waiting for these
+  // vertices + shown) (the shown set is brought up to date), plus O(V) when
   // the cache bound evicts (once per bound/8 deliveries); allocation: the eviction's candidates.
   status deliver(std::span<const std::uint32_t> vertices, std::span<const glm::vec3> colours) {
     if (vertices.size() != colours.size())
@@ -288,8 +290,9 @@ class progressive_refiner {
   // needs every earlier request delivered, so without a renderer behind the call (this
   // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
   // Preconditions: a view was set. Complexity per batch: the criterion's selection
-  // (criteria.hpp) + O(R) splits + O(visible + in-view triangles) + O(pixels of the split leaves
-  // · level) for the re-location + O(pixels whose shown triangle changed · log pixels).
+  // (criteria.hpp) + O(R) splits + O(visible) (finding the split leaves) + O(pixels of the split
+  // leaves · level) for the re-location + O(subtrees under the split leaves' parents + shown) for
+  // the shown cut + O(pixels whose shown triangle changed · log pixels).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
