@@ -293,3 +293,51 @@ TEST_CASE("driver: errors") {
   CHECK(st.code() == errc::index_out_of_range);
   CHECK(st.element() == 0);
 }
+
+TEST_CASE("driver: NLD_IS appends a full batch after what the caller's vector already holds") {
+  const auto m = floor_mesh();
+  const auto cam = top_camera();
+  auto shade = [](const shading_point& sp) { return shadowed(sp.position); };
+  const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = 0.05f, .batch = 4};
+  auto r = make_refiner(m, {.criteria = o});
+  REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+  REQUIRE(r.refine(shade) == refine_progress::refined);  // the luminance image is filled
+  std::vector<std::uint32_t> alone;
+  select_nld_is(r.frame(), o, alone);
+  REQUIRE(!alone.empty());
+  std::vector<std::uint32_t> after(6, 12345u);  // more entries than R
+  select_nld_is(r.frame(), o, after);
+  REQUIRE(after.size() == 6 + alone.size());
+  CHECK(std::equal(alone.begin(), alone.end(), after.begin() + 6));
+}
+
+TEST_CASE("driver: options and cameras at their extremes get a status naming them, before any cast or allocation") {
+  const auto m = floor_mesh();
+  auto s = subdivision_mesh::create(m);
+  REQUIRE(s.ok());
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (float bad : {inf, 1e30f, nan, -1.0f, std::nextafter(criteria_options::max_rnd_point_fraction, inf)}) {
+    INFO("rnd_point_fraction " << bad);
+    const auto r = progressive_refiner::create(*s, {.criteria = {.rnd_point_fraction = bad}});
+    REQUIRE(!r.ok());
+    CHECK(r.error().code() == errc::bad_parameter);
+    CHECK(r.error().message().find("rnd_point_fraction") != std::string::npos);
+  }
+  CHECK(progressive_refiner::create(*s, {.criteria = {.rnd_point_fraction = criteria_options::max_rnd_point_fraction}}).ok());
+  for (float bad : {nan, -1.0f}) {
+    CHECK(progressive_refiner::create(*s, {.criteria = {.min_pixels = bad}}).error().code() == errc::bad_parameter);
+    CHECK(progressive_refiner::create(*s, {.criteria = {.always_refine_fraction = bad}}).error().code() == errc::bad_parameter);
+    CHECK(progressive_refiner::create(*s, {.criteria = {.nld_is_pixel_fraction = bad}}).error().code() == errc::bad_parameter);
+  }
+  // A 0xffffffff x 0xffffffff image passes every camera check but no allocation can hold it.
+  auto r = make_refiner(m, {});
+  auto shade = [](const shading_point&) { return glm::vec3(1.0f); };
+  pinhole_camera huge = top_camera(0xffffffffu, 0xffffffffu);
+  const status st = r.set_view(brute_force_tracer{&m}, huge);
+  CHECK(st.code() == errc::bad_parameter);
+  CHECK(st.message().find("pixels") != std::string::npos);
+  CHECK(r.start(brute_force_tracer{&m}, huge, shade, serial_executor{}).code() == errc::bad_parameter);
+  huge = top_camera(1u << 13, (progressive_refiner::max_view_pixels >> 13) + 1);  // one row past the limit
+  CHECK(r.set_view(brute_force_tracer{&m}, huge).code() == errc::bad_parameter);
+  CHECK(r.visible_leaves().empty());  // nothing was taken
+}

@@ -249,17 +249,35 @@ TEST_CASE("walkthrough: the cache bound is honoured and changes no image") {
   const std::size_t bound = per_view + per_view / 4;
   REQUIRE(bound < unbounded.cached_samples());  // the bound bites
   auto r = make_agent({.max_cached_samples = bound});
+  // Every eviction brings the cache down to its low-water mark (hysteresis), not just to the bound.
+  std::size_t before = 0, evictions = 0;
+  const auto check_bound = [&] {
+    const std::size_t now = r.cached_samples();
+    CHECK(now <= bound);
+    if (now < before) {  // evicted: down to the mark, or nothing outside the view is left
+      ++evictions;
+      std::set<std::uint32_t> in_view;
+      for (std::uint32_t leaf : r.visible_leaves())
+        for (std::uint32_t t = leaf; t != invalid_id; t = r.mesh().triangle(t).parent)
+          for (int c = 0; c < 3; ++c)
+            if (r.vertex_shaded(r.mesh().triangle(t).vertices[c])) in_view.insert(r.mesh().triangle(t).vertices[c]);
+      CHECK((now <= bound - bound / 8 || now == in_view.size()));
+    }
+    before = now;
+  };
   for (std::uint32_t f = 0; f < FRAMES; ++f) {
     REQUIRE(r.set_view(scene(), support::walkthrough_path(f, FRAMES, W, H), ex).ok());
+    check_bound();
     r.shade_requests(shader(), ex);
-    CHECK(r.cached_samples() <= bound);
+    check_bound();
     refine_progress p;
-    while ((p = r.refine(shader(), {}, ex)) == refine_progress::refined) CHECK(r.cached_samples() <= bound);
+    while ((p = r.refine(shader(), {}, ex)) == refine_progress::refined) check_bound();
     CHECK(p == refine_progress::finished);  // the bound never stopped refinement here
     INFO("frame " << f);
     CHECK(same_bits(image_of(r), reference.images[f]));
   }
   CHECK(r.samples_delivered() > reference.samples.back());  // evicted samples were shaded again
+  CHECK(evictions > 0);
 }
 
 TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
@@ -310,7 +328,10 @@ TEST_CASE("walkthrough: bad input gets a clear status and changes nothing") {
   ids = {req[0].vertex, static_cast<std::uint32_t>(r.mesh().vertex_count())};
   CHECK(r.deliver(ids, colours).code() == errc::index_out_of_range);
   ids = {req[1].vertex, req[1].vertex};
-  CHECK(r.deliver(ids, colours).code() == errc::bad_parameter);
+  const status dup = r.deliver(ids, colours);
+  CHECK(dup.code() == errc::bad_parameter);
+  CHECK(dup.element() == 1);
+  CHECK(dup.message().find("twice") != std::string::npos);
   ids = {req[0].vertex, req[1].vertex};
   colours[1].y = std::numeric_limits<float>::quiet_NaN();
   CHECK(r.deliver(ids, colours).code() == errc::non_finite);
@@ -361,4 +382,104 @@ TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS s
   REQUIRE(bad.ok());
   CHECK(progressive_refiner::create(std::move(*bad), {.criteria = {.nld_is_pixel_fraction = -1.0f}}).error().code() ==
         errc::bad_parameter);
+}
+
+namespace {
+
+// FNV-1a over everything a walk produces that must not change when the agent gets faster.
+struct fingerprint {
+  std::uint64_t h = 1469598103934665603ull;
+  void add(const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  }
+  void add(std::uint64_t v) { add(&v, sizeof v); }
+  void add(const std::vector<std::uint32_t>& v) {
+    add(v.size());
+    add(v.data(), v.size() * sizeof(std::uint32_t));
+  }
+};
+
+// The 120-frame path as infolerp_pareto walk drives it (asynchronous requests, a delta after
+// every delivery and every batch): per frame the samples, every delta, the final image and
+// Table 1's Δ, samples, batches and selections. Restart: start() per frame.
+std::uint64_t walk_fingerprint(refinement_criterion c, bool restart) {
+  serial_executor ex;
+  auto r = make_agent({.criteria = {.criterion = c, .s_req = 0.05f, .always_refine_fraction = 0.02f, .batch = 64}});
+  fingerprint fp;
+  display_delta delta;
+  const auto take = [&] {
+    r.take_delta(delta);
+    fp.add(delta.added_from_cache);
+    fp.add(delta.deleted);
+    fp.add(delta.newly_shaded);
+  };
+  constexpr std::uint32_t frames = 120;
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    const pinhole_camera cam = support::walkthrough_path(f, frames, W, H);
+    REQUIRE((restart ? r.start(scene(), cam, ex) : r.set_view(scene(), cam, ex)).ok());
+    take();
+    for (;;) {
+      std::vector<shading_point> req;
+      r.take_requests(req);
+      std::vector<std::uint32_t> ids;
+      std::vector<glm::vec3> colours;
+      for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
+      REQUIRE(r.deliver(ids, colours).ok());
+      take();
+      if (r.refine({}, ex) != refine_progress::refined) break;
+    }
+    const auto img = image_of(r);
+    fp.add(img.data(), img.size() * sizeof(glm::vec3));
+    const refinement_report& rep = r.report();
+    for (std::uint64_t v : {std::uint64_t(r.samples_delivered()), std::uint64_t(rep.stage1.triangles),
+                            std::uint64_t(rep.stage1.shading_samples), std::uint64_t(rep.stage2.triangles),
+                            std::uint64_t(rep.stage2.shading_samples), std::uint64_t(rep.batches),
+                            std::uint64_t(rep.selections)})
+      fp.add(v);
+  }
+  return fp.h;
+}
+
+}  // namespace
+
+TEST_CASE("walkthrough: the 120-frame path gives the same samples, deltas and images as before the agent got faster",
+          "[walk_golden]") {
+  // Recorded with the agent that rescanned the whole hierarchy and image every batch.
+  CHECK(walk_fingerprint(refinement_criterion::nld_os, false) == 0xa4f4f4b0401648f0ull);
+  CHECK(walk_fingerprint(refinement_criterion::nld_os, true) == 0xa6997f7302c5a153ull);
+  CHECK(walk_fingerprint(refinement_criterion::rnd, false) == 0x0c23c5cd7ee8a551ull);
+}
+
+TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the current view") {
+  serial_executor ex;
+  auto r = make_agent();
+  display_delta delta;
+  std::size_t sent = 0;
+  const auto take = [&] {
+    r.take_delta(delta);
+    sent += delta.added_from_cache.size() + delta.newly_shaded.size();
+  };
+  for (std::uint32_t f = 0; f < FRAMES; ++f) {
+    const pinhole_camera cam = support::walkthrough_path(f, FRAMES, W, H);
+    REQUIRE((f == 0 ? r.start(scene(), cam, ex) : r.set_view(scene(), cam, ex)).ok());
+    sent = 0;
+    take();
+    for (;;) {
+      std::vector<shading_point> req;
+      r.take_requests(req);
+      std::vector<std::uint32_t> ids;
+      std::vector<glm::vec3> colours;
+      for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
+      REQUIRE(r.deliver(ids, colours).ok());
+      take();
+      if (r.refine({}, ex) != refine_progress::refined) break;
+      take();
+    }
+    INFO("frame " << f);
+    if (f == 0) CHECK(r.report().stage1.triangles_total == r.report().stage1.triangles);  // all sent at once
+    CHECK(r.report().stage2.triangles_total == sent);
+  }
+  // A revisited view sends only what changed: the last frame is the first one's camera.
+  CHECK(r.report().stage2.triangles_total < r.report().stage2.triangles);
 }

@@ -54,13 +54,19 @@ struct criteria_options {
   float min_pixels = 6.0f;               // skip triangles projecting onto fewer pixels (paper: 6)
   float always_refine_fraction = 0.02f;  // NLD_OS: refine triangles covering more of the image regardless of S
   std::uint32_t batch = 64;              // R: triangles selected per batch
-  float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count
+  float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count, in [0, max_rnd_point_fraction]
   float nld_is_pixel_fraction = std::numeric_limits<float>::infinity();  // NLD_IS: stop once the view's requests reach this fraction of the pixels
   float random_share = 0.0f;             // NLD_OS: share of each batch given to a random pass (0: none)
   std::uint64_t seed = 1;                // RND: random sequence
+
+  // Largest rnd_point_fraction: a million draws per pixel, far past where RND finds anything new,
+  // and small enough that the point budget of any image fits an integer exactly.
+  static constexpr float max_rnd_point_fraction = 1e6f;
 };
 
-// Checks option ranges. Errors name the member. O(1); allocation: the message on error.
+// Checks option ranges (NaN fails every check). An infinite min_pixels or always_refine_fraction
+// is defined (no leaf qualifies / none is forced), an infinite nld_is_pixel_fraction is the
+// default (no pixel budget). Errors name the member. O(1); allocation: the message on error.
 inline status validate(const criteria_options& o) {
   if (!(o.s_req >= 0.0f && o.s_req <= 1.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.s_req ", o.s_req, " outside [0, 1]");
@@ -71,8 +77,9 @@ inline status validate(const criteria_options& o) {
   if (o.batch == 0) return make_error(errc::bad_parameter, no_element, "criteria_options.batch must be >= 1");
   if (!(o.nld_is_pixel_fraction >= 0.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.nld_is_pixel_fraction must be >= 0");
-  if (!(o.rnd_point_fraction >= 0.0f))
-    return make_error(errc::bad_parameter, no_element, "criteria_options.rnd_point_fraction must be >= 0");
+  if (!(o.rnd_point_fraction >= 0.0f && o.rnd_point_fraction <= criteria_options::max_rnd_point_fraction))
+    return make_error(errc::bad_parameter, no_element, "criteria_options.rnd_point_fraction ", o.rnd_point_fraction,
+                      " outside [0, ", criteria_options::max_rnd_point_fraction, "]");
   if (!(o.random_share >= 0.0f && o.random_share <= 1.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.random_share ", o.random_share, " outside [0, 1]");
   return {};
@@ -138,7 +145,7 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
 }
 
 // NLD_IS (§4): best-first quadtree walk over the interpolated image (see the header comment).
-// Appends up to R ids. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
+// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
 inline void select_nld_is(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
   if (f.width == 0 || f.height == 0) return;
   if (double(f.view_samples) >= double(o.nld_is_pixel_fraction) * double(f.width) * double(f.height)) return;
@@ -165,7 +172,8 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
   };
   push_children(0, 0, f.width, f.height);
   std::vector<std::uint32_t> chosen;
-  while (!heap.empty() && out.size() < o.batch) {
+  const std::size_t goal = out.size() + o.batch;
+  while (!heap.empty() && out.size() < goal) {
     const quad q = heap.top();
     heap.pop();
     if (!(q.s > o.s_req)) break;  // every other quadrant has an S at most this large
@@ -185,7 +193,9 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
 inline void select_rnd(const refinement_frame& f, const criteria_options& o, criterion_state& st,
                        std::vector<std::uint32_t>& out, std::size_t first, std::size_t count) {
   const std::uint64_t pixels = std::uint64_t(f.width) * f.height;
-  const auto cap = static_cast<std::uint64_t>(double(o.rnd_point_fraction) * double(pixels));
+  // validate() bounds the fraction; the clamp keeps the cast defined for any frame.
+  const double budget = std::min(double(o.rnd_point_fraction) * double(pixels), 0x1p63);
+  const auto cap = budget >= 0.0 ? static_cast<std::uint64_t>(budget) : std::uint64_t{0};
   const std::size_t goal = out.size() + count;
   // At most 8·count draws per batch, so one batch cannot burn the whole point budget on the
   // same few triangles; a batch whose draws all miss ends the random work (returns nothing).

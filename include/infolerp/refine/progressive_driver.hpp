@@ -9,7 +9,7 @@
 // without tracing. Hierarchy and cache survive view changes; only leaves shown now are refined,
 // requested or displayed. start() is a full restart.
 // Cache: one colour per hierarchy vertex (object space, the paper's Lambertian restriction),
-// 20 bytes per vertex plus 32 per hierarchy triangle. With max_cached_samples, vertices outside
+// 20 bytes per vertex plus 40 per hierarchy triangle. With max_cached_samples, vertices outside
 // the view are evicted least recently visible first; the current view's are never evicted, and
 // refinement stops (cache_full) once they alone reach the bound.
 // Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
@@ -25,7 +25,12 @@
 // take_delta() gives the changes in the paper's order: added from the cache, deleted, newly shaded.
 // Figures: stage 1 shades every visible leaf's vertices; stage 2 runs batches (criteria.hpp)
 // until the criterion selects nothing, the budget is reached (checked per batch) or max_batches
-// ran. Δ: leaves shown now; Δ_total: triangles ever shown since start().
+// ran. Δ: triangles shown now; Δ_total: triangles sent to the visualizer since the view was set
+// (those that entered the shown set; a new view sends only what the previous one did not show).
+// Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split
+// and the visible set, never the whole image or the hierarchy outside the view; the shown cut is
+// recomputed only under what a batch split or a delivery made ready; the luminance image and
+// L_max follow the leaves whose shown triangle changed.
 //
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
@@ -34,6 +39,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <span>
 #include <type_traits>
@@ -140,6 +146,10 @@ struct display_delta {
 // executor). Accessors below are O(1) and allocate nothing.
 class progressive_refiner {
  public:
+  // Largest image a view may have (width · height): 2^25 pixels (8192 x 4096, above 8K UHD);
+  // the agent keeps about 60 bytes per pixel, so a view stays under 2 GB.
+  static constexpr std::size_t max_view_pixels = std::size_t{1} << 25;
+
   // Takes over a subdivision mesh (possibly already tessellated, §4.1 of the clustering paper);
   // start() returns to it, so a copy is kept. Errors: options out of range (names the member).
   // O(mesh) for the copy.
@@ -181,11 +191,11 @@ class progressive_refiner {
   // A new view: visibility recomputed, hierarchy and cache kept, requests issued for the newly
   // visible unshaded vertices, the criterion's per-view state (RND's draws) and the report
   // restarted. May be called at any time, with requests outstanding (they stay valid).
-  // Errors: an empty image; a camera with non-finite eye/target/up, eye == target, up parallel
+  // Errors: an empty image or one of more than max_view_pixels; a camera with non-finite eye/target/up, eye == target, up parallel
   // to the view direction or a field of view outside (0, 180); a hit naming a triangle the
   // mesh does not have or with a non-finite distance or barycentric (names the pixel). On error
-  // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level);
-  // allocation O(pixels + triangles + vertices).
+  // the refiner is unchanged. Complexity O(pixels · (trace + level) + visible · level), not
+  // the hierarchy's size; allocation O(pixels), per-triangle arrays grow with the hierarchy.
   template <class T, class Camera, class E = serial_executor>
   status set_view(const T& tracer, const Camera& camera, E&& exec = E{}) {
     return view(tracer, camera, exec, false);
@@ -207,15 +217,17 @@ class progressive_refiner {
   // Accepts the colours of requested vertices, in any order and any grouping. Errors: sizes
   // differ; a vertex out of range, never requested, already delivered, or named twice; a
   // non-finite colour (names the entry). On error nothing is stored.
-  // Complexity O(n + visible · level) (the shown set is brought up to date), plus
-  // O(V log V) when the cache bound evicts; allocation: the eviction's candidate list.
+  // Complexity O(n + the in-view subtrees under the parents of the triangles waiting for these
+  // vertices + shown) (the shown set is brought up to date), plus O(V) when
+  // the cache bound evicts (once per bound/8 deliveries); allocation: the eviction's candidates.
   status deliver(std::span<const std::uint32_t> vertices, std::span<const glm::vec3> colours) {
     if (vertices.size() != colours.size())
       return make_error(errc::bad_size, no_element, "deliver: ", vertices.size(), " vertices but ", colours.size(), " colours");
     std::size_t bad = no_index;
+    bool named_twice = false;
     for (std::size_t i = 0; i < vertices.size() && bad == no_index; ++i) {
       const std::uint32_t v = vertices[i];
-      if (v >= vstate_.size() || vstate_[v] != requested) bad = i;
+      if (v >= vstate_.size() || vstate_[v] != requested) bad = i, named_twice = v < vstate_.size() && vstate_[v] == delivering;
       else vstate_[v] = delivering;
     }
     for (std::size_t i = 0; i < vertices.size(); ++i)  // undo the marks (duplicates stay detectable above)
@@ -225,6 +237,9 @@ class progressive_refiner {
       if (v >= vstate_.size())
         return make_error(errc::index_out_of_range, bad, "deliver: entry ", bad, ": vertex ", v, " out of range (",
                           vstate_.size(), " vertices)");
+      if (named_twice)
+        return make_error(errc::bad_parameter, bad, "deliver: entry ", bad, ": vertex ", v, " is named twice (first at entry ",
+                          std::find(vertices.begin(), vertices.end(), v) - vertices.begin(), ")");
       return make_error(errc::bad_parameter, bad, "deliver: entry ", bad, ": vertex ", v,
                         vstate_[v] == shaded ? " was already delivered" : " has no outstanding request");
     }
@@ -242,7 +257,9 @@ class progressive_refiner {
     samples_ += vertices.size();
     shaded_count_ += vertices.size();
     enforce_cache_bound();
-    update_display();
+    begin_display_update();
+    for (std::uint32_t v : vertices) seed_waiters(v);
+    finish_display_update();
     return {};
   }
 
@@ -273,7 +290,9 @@ class progressive_refiner {
   // needs every earlier request delivered, so without a renderer behind the call (this
   // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
   // Preconditions: a view was set. Complexity per batch: the criterion's selection
-  // (criteria.hpp) + O(R) splits + O(pixels) re-location + O(visible · level).
+  // (criteria.hpp) + O(R) splits + O(visible) (finding the split leaves) + O(pixels of the split
+  // leaves · level) for the re-location + O(subtrees under the split leaves' parents + shown) for
+  // the shown cut + O(pixels whose shown triangle changed · log pixels).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
@@ -396,8 +415,11 @@ class progressive_refiner {
   template <class Camera>
   static status check_camera(const Camera& camera) {
     const std::uint32_t width = camera.width, height = camera.height;
-    if (std::size_t(width) * height == 0)
-      return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
+    const std::uint64_t pixels = std::uint64_t(width) * height;
+    if (pixels == 0) return make_error(errc::empty_input, no_element, "camera image is ", width, "x", height);
+    if (pixels > max_view_pixels)
+      return make_error(errc::bad_parameter, no_element, "camera image ", width, "x", height, " has ", pixels,
+                        " pixels, more than max_view_pixels (", max_view_pixels, ")");
     if constexpr (requires { camera.eye; camera.target; camera.up; camera.vertical_fov_degrees; }) {
       const glm::vec3 e = camera.eye, t = camera.target, u = camera.up;
       for (int k = 0; k < 3; ++k)
@@ -460,8 +482,17 @@ class progressive_refiner {
     state_.rng = splitmix64{options_.criteria.seed};
     pixel_luminance_.clear();
     in_view_.clear();
-    ever_shown_.clear();
-    ever_shown_count_ = 0;
+    visible_.clear();
+    leaf_pixels_.clear();
+    leaf_head_.clear();
+    display_of_.clear();
+    dirty_.clear();
+    dirty_mark_.clear();
+    dirty_clock_ = 1;
+    shown_count_.clear();
+    waiters_.clear();
+    waiter_head_.clear();
+    waiter_clock_.clear();
     vstate_.clear();
     colour_.clear();
     luminance_.clear();
@@ -502,7 +533,8 @@ class progressive_refiner {
     state_.points_drawn = 0;
     state_.exhausted = false;
     report_ = {};
-    update_view(exec);
+    sent_total_ = 0;
+    view_leaves(exec);
   }
 
   [[nodiscard]] bool done() const {
@@ -544,7 +576,7 @@ class progressive_refiner {
       }
       ++report_.batches;
       report_.selections += selected_.size();
-      update_view(exec);
+      follow_splits();
       render(exec);
       report_.stage2 = figures();
     }
@@ -579,17 +611,46 @@ class progressive_refiner {
   [[nodiscard]] stage_figures figures() const {
     stage_figures s;
     s.triangles = visible_.size();
-    s.triangles_total = ever_shown_count_;
+    s.triangles_total = sent_total_;
     s.triangles_produced = mesh_.triangle_count();
     s.shading_samples = samples_;
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
     return s;
   }
 
-  // Pixels whose leaf was split follow it down; projected areas, the visible set, the in-view
-  // marks, the requests and the shown set are brought up to date.
+  void grow() {
+    const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
+    leaf_pixels_.resize(nt, 0);
+    leaf_head_.resize(nt, invalid_id);
+    in_view_.resize(nt, 0);
+    display_of_.resize(nt, invalid_id);
+    dirty_mark_.resize(nt, 0);
+    shown_count_.resize(nt, 0);
+    decided_.resize(nt, 0);
+    shown_mark_.resize(nt, 0);
+    decision_.resize(nt);
+    waiter_head_.resize(nv, invalid_id);
+    waiter_clock_.resize(nv, 0);
+    vstate_.resize(nv, unshaded);
+    colour_.resize(nv, glm::vec3(0.0f));
+    luminance_.resize(nv, 0.0f);
+    last_seen_.resize(nv, 0);
+    delivered_epoch_.resize(nv, 0);
+  }
+
+  // Puts pixel p on its leaf's list; a leaf's first pixel makes it visible (fresh_).
+  void add_pixel(std::uint32_t p, std::uint32_t leaf) {
+    pixel_next_[p] = leaf_head_[leaf];
+    leaf_head_[leaf] = p;
+    if (leaf_pixels_[leaf]++ == 0) fresh_.push_back(leaf);
+  }
+
+  // A new view: every pixel is located from its hit's original triangle and listed under its
+  // leaf; the previous view's lists are dropped through its visible leaves, so the hierarchy
+  // outside both views costs nothing. O(pixels · level + previous visible).
   template <class E>
-  void update_view(E&& exec) {
+  void view_leaves(E&& exec) {
+    for (std::uint32_t t : visible_) leaf_pixels_[t] = 0, leaf_head_[t] = invalid_id;
     const std::size_t n = pixel_leaf_.size();
     exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) {
@@ -600,27 +661,63 @@ class progressive_refiner {
         pixel_weights_[p] = loc.weights;
       }
     });
-    const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
-    leaf_pixels_.assign(nt, 0);
-    ever_shown_.resize(nt, 0);
-    in_view_.resize(nt, 0);
-    display_of_.resize(nt, invalid_id);
-    vstate_.resize(nv, unshaded);
-    colour_.resize(nv, glm::vec3(0.0f));
-    luminance_.resize(nv, 0.0f);
-    last_seen_.resize(nv, 0);
-    delivered_epoch_.resize(nv, 0);
-    for (std::uint32_t leaf : pixel_leaf_)
-      if (leaf != invalid_id) ++leaf_pixels_[leaf];
-    visible_.clear();  // ascending by a scan: cheaper than sorting the leaves as found
-    for (std::uint32_t t = 0; t < nt; ++t)
-      if (leaf_pixels_[t] != 0) visible_.push_back(t);
-    for (std::uint32_t t : visible_)
-      if (!ever_shown_[t]) ever_shown_[t] = 1, ++ever_shown_count_;
-    // In view: the visible leaves and their ancestors; their corners are stamped and requested.
+    grow();
+    pixel_next_.resize(n);
+    fresh_.clear();
+    for (std::size_t p = 0; p < n; ++p)
+      if (pixel_leaf_[p] != invalid_id) add_pixel(static_cast<std::uint32_t>(p), pixel_leaf_[p]);
+    std::sort(fresh_.begin(), fresh_.end());
+    visible_.swap(fresh_);
     ++clock_;
     in_view_vertices_ = 0;
-    for (std::uint32_t leaf : visible_)
+    all_dirty_ = true;
+    waiters_.clear();
+    stamp_in_view(visible_);
+    enforce_cache_bound();
+    update_display();
+  }
+
+  // After a batch's splits: only the pixels of the visible leaves that were split follow them
+  // down (pixel lists), the visible set loses those leaves and gains the children that cover
+  // pixels, and only the new leaves are walked up for the in-view marks and requests (the
+  // in-view set of a view only grows). O(visible + pixels of the split leaves · level).
+  void follow_splits() {
+    grow();
+    fresh_.clear();
+    begin_display_update();
+    for (std::uint32_t t : visible_) {
+      if (mesh_.is_leaf(t)) continue;
+      set_display(t, invalid_id);  // no longer a visible leaf
+      seeds_.push_back(mesh_.triangle(t).parent != invalid_id ? mesh_.triangle(t).parent : t);
+      std::uint32_t p = leaf_head_[t];
+      leaf_head_[t] = invalid_id;
+      leaf_pixels_[t] = 0;
+      while (p != invalid_id) {
+        const std::uint32_t next = pixel_next_[p];
+        const point_location loc = mesh_.locate_from(t, pixel_weights_[p]);
+        pixel_leaf_[p] = loc.leaf;
+        pixel_weights_[p] = loc.weights;
+        add_pixel(p, loc.leaf);
+        p = next;
+      }
+    }
+    if (fresh_.empty()) return finish_display_update();
+    std::sort(fresh_.begin(), fresh_.end());
+    for (std::uint32_t t : fresh_) mark_dirty(t);
+    visible_.erase(std::remove_if(visible_.begin(), visible_.end(), [&](std::uint32_t t) { return leaf_pixels_[t] == 0; }),
+                   visible_.end());
+    const auto middle = static_cast<std::ptrdiff_t>(visible_.size());
+    visible_.insert(visible_.end(), fresh_.begin(), fresh_.end());
+    std::inplace_merge(visible_.begin(), visible_.begin() + middle, visible_.end());
+    stamp_in_view(fresh_);
+    enforce_cache_bound();
+    finish_display_update();
+  }
+
+  // In view: the given leaves and their ancestors up to the first already marked; their corners
+  // are stamped and requested.
+  void stamp_in_view(std::span<const std::uint32_t> leaves) {
+    for (std::uint32_t leaf : leaves)
       for (std::uint32_t t = leaf; t != invalid_id && in_view_[t] != clock_; t = mesh_.triangle(t).parent) {
         in_view_[t] = clock_;
         const glm::uvec3 v = mesh_.triangle(t).vertices;
@@ -628,10 +725,33 @@ class progressive_refiner {
           if (last_seen_[v[c]] != clock_) ++in_view_vertices_;
           last_seen_[v[c]] = clock_;
           if (vstate_[v[c]] == unshaded) vstate_[v[c]] = requested, to_issue_.push_back(v[c]), ++outstanding_, ++view_requests_;
+          if (vstate_[v[c]] != shaded) add_waiter(v[c], t);
         }
       }
-    enforce_cache_bound();
-    update_display();
+  }
+
+  // Triangles of the view waiting for a vertex (one list per vertex, valid for clock_'s view).
+  void add_waiter(std::uint32_t v, std::uint32_t t) {
+    if (waiter_clock_[v] != clock_) waiter_clock_[v] = clock_, waiter_head_[v] = invalid_id;
+    waiters_.push_back({t, waiter_head_[v]});
+    waiter_head_[v] = static_cast<std::uint32_t>(waiters_.size() - 1);
+  }
+  // A delivered vertex: the shown cut may change under the parents of the triangles waiting for it
+  // (their readiness, and so their parents' expansion).
+  void seed_waiters(std::uint32_t v) {
+    if (waiter_clock_[v] != clock_) return;
+    for (std::uint32_t i = waiter_head_[v]; i != invalid_id; i = waiters_[i].next) {
+      const std::uint32_t t = waiters_[i].triangle, parent = mesh_.triangle(t).parent;
+      seeds_.push_back(parent != invalid_id ? parent : t);
+    }
+    waiter_head_[v] = invalid_id;
+  }
+
+  // A leaf whose pixels' colours may have changed since the last luminance image.
+  void mark_dirty(std::uint32_t leaf) {
+    if (all_dirty_ || dirty_mark_[leaf] == dirty_clock_) return;
+    dirty_mark_[leaf] = dirty_clock_;
+    dirty_.push_back(leaf);
   }
 
   // The current view alone fills the cache: nothing is left to evict.
@@ -664,7 +784,9 @@ class progressive_refiner {
     decided_.resize(nt, 0);
     shown_mark_.resize(nt, 0);
     decision_.resize(nt);
-    shown_.clear();
+    previous_shown_.swap(shown_);
+    shown_.clear();  // leaves shown themselves, ascending as visible_ is
+    shown_above_.clear();  // ancestors shown for their leaves, each once
     for (std::uint32_t leaf : visible_) {
       path_.clear();
       std::uint32_t t = leaf;
@@ -678,22 +800,111 @@ class progressive_refiner {
         decided_[*it] = display_clock_;
         decision_[*it] = above;
       }
-      display_of_[leaf] = above.shown;
-      if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
-        shown_mark_[above.shown] = display_clock_, shown_.push_back(above.shown);
+      if (display_of_[leaf] != above.shown) display_of_[leaf] = above.shown, mark_dirty(leaf);
+      if (above.shown == leaf) shown_.push_back(leaf);
+      else if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
+        shown_mark_[above.shown] = display_clock_, shown_above_.push_back(above.shown);
     }
-    std::sort(shown_.begin(), shown_.end());
+    if (!shown_above_.empty()) {  // sorting only the ancestors: O(shown + ancestors · log)
+      std::sort(shown_above_.begin(), shown_above_.end());
+      merged_.resize(shown_.size() + shown_above_.size());
+      std::merge(shown_.begin(), shown_.end(), shown_above_.begin(), shown_above_.end(), merged_.begin());
+      shown_.swap(merged_);
+    }
+    for (std::uint32_t t : previous_shown_) shown_count_[t] = 0;
+    for (std::uint32_t leaf : visible_)
+      if (display_of_[leaf] != invalid_id) ++shown_count_[display_of_[leaf]];
+    // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
+    std::size_t kept = 0;
+    for (std::size_t i = 0, j = 0; i < shown_.size() && j < previous_shown_.size();)
+      if (shown_[i] < previous_shown_[j]) ++i;
+      else if (previous_shown_[j] < shown_[i]) ++j;
+      else ++kept, ++i, ++j;
+    sent_total_ += shown_.size() - kept;
   }
 
-  // Least recently visible first (ties by id), never a vertex of the current view.
+  // The shown cut brought up to date under seed triangles only (split leaves' parents, parents of
+  // triangles that got a corner delivered): each in-view triangle's decision depends on its
+  // parent's, its own readiness and its in-view children's, so the seeds' in-view subtrees,
+  // parents first, are all that can change. The shown set follows per-triangle counts of the
+  // visible leaves showing it. O(seeded subtrees + shown); the same cut as update_display().
+  void begin_display_update() {
+    if (++display_clock_ == 0) {
+      std::fill(decided_.begin(), decided_.end(), 0u);
+      std::fill(shown_mark_.begin(), shown_mark_.end(), 0u);
+      display_clock_ = 1;
+    }
+    seeds_.clear();
+    touched_.clear();
+  }
+  void set_display(std::uint32_t leaf, std::uint32_t shown) {
+    const std::uint32_t old = display_of_[leaf];
+    if (old == shown) return;
+    if (old != invalid_id) touch(old), --shown_count_[old];
+    if (shown != invalid_id) touch(shown), ++shown_count_[shown];
+    display_of_[leaf] = shown;
+    mark_dirty(leaf);
+  }
+  void touch(std::uint32_t t) {
+    if (shown_mark_[t] == display_clock_) return;
+    shown_mark_[t] = display_clock_;
+    touched_.push_back({t, shown_count_[t] > 0});
+  }
+  void finish_display_update() {
+    std::sort(seeds_.begin(), seeds_.end(), [&](std::uint32_t a, std::uint32_t b) {
+      const auto la = mesh_.triangle(a).level, lb = mesh_.triangle(b).level;
+      return la != lb ? la < lb : a < b;
+    });
+    for (std::uint32_t s : seeds_) {
+      if (in_view_[s] != clock_ || decided_[s] == display_clock_) continue;
+      stack_.push_back(s);
+      while (!stack_.empty()) {
+        const std::uint32_t t = stack_.back();
+        stack_.pop_back();
+        decided_[t] = display_clock_;
+        const subdivision_triangle& n = mesh_.triangle(t);
+        display_step above = n.parent == invalid_id ? display_step{invalid_id, true} : decision_[n.parent];
+        const bool leaf = n.is_leaf();
+        if (above.open) {
+          if (!ready(t)) above.open = false;
+          else above = {t, !leaf && expands(t)};
+        }
+        decision_[t] = above;
+        if (leaf) set_display(t, above.shown);
+        for (std::uint32_t c = n.first_child; c < n.first_child + n.child_count; ++c)
+          if (in_view_[c] == clock_) stack_.push_back(c);
+      }
+    }
+    added_.clear();
+    removed_.clear();
+    for (const touched_triangle& x : touched_) {
+      const bool now = shown_count_[x.triangle] > 0;
+      if (now && !x.was) added_.push_back(x.triangle);
+      if (!now && x.was) removed_.push_back(x.triangle);
+    }
+    if (added_.empty() && removed_.empty()) return;
+    std::sort(added_.begin(), added_.end());
+    std::sort(removed_.begin(), removed_.end());
+    merged_.clear();
+    std::set_difference(shown_.begin(), shown_.end(), removed_.begin(), removed_.end(), std::back_inserter(merged_));
+    shown_.resize(merged_.size() + added_.size());
+    std::merge(merged_.begin(), merged_.end(), added_.begin(), added_.end(), shown_.begin());
+    sent_total_ += added_.size();
+  }
+
+  // Least recently visible first (ties by id), never a vertex of the current view. Past the bound
+  // the cache is brought down to its low-water mark, bound − bound/8, so the O(vertices) scan
+  // runs once per bound/8 deliveries, not on every one.
   void enforce_cache_bound() {
-    if (shaded_count_ <= options_.max_cached_samples) return;
+    const std::size_t bound = options_.max_cached_samples;
+    if (shaded_count_ <= bound) return;
     evict_.clear();
     for (std::uint32_t v = 0; v < vstate_.size(); ++v)
       if (vstate_[v] == shaded && last_seen_[v] != clock_) evict_.push_back(v);
-    const std::size_t excess = std::min(shaded_count_ - options_.max_cached_samples, evict_.size());
-    std::partial_sort(evict_.begin(), evict_.begin() + std::ptrdiff_t(excess), evict_.end(),
-                      [&](std::uint32_t a, std::uint32_t b) { return last_seen_[a] != last_seen_[b] ? last_seen_[a] < last_seen_[b] : a < b; });
+    const std::size_t excess = std::min(shaded_count_ - (bound - bound / 8), evict_.size());
+    if (excess == 0) return;
+    std::nth_element(evict_.begin(), evict_.begin() + std::ptrdiff_t(excess - 1), evict_.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return last_seen_[a] != last_seen_[b] ? last_seen_[a] < last_seen_[b] : a < b; });
     for (std::size_t i = 0; i < excess; ++i) {
       const std::uint32_t v = evict_[i];
       vstate_[v] = unshaded;
@@ -716,15 +927,33 @@ class progressive_refiner {
     return sp;
   }
 
-  // The interpolated luminance per pixel and L_max, its maximum over the image (§4).
+  // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
+  // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
+  // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
+  // 1, pixel p at n + p). O(pixels) per view, O(dirty pixels · log pixels) per batch.
   template <class E>
   void luminance_image(E&& exec) {
-    pixel_luminance_.resize(pixel_leaf_.size());
-    exec.parallel_for(pixel_leaf_.size(), options_.grain, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t p = begin; p < end; ++p) pixel_luminance_[p] = luminance(pixel_colour(p));
-    });
-    l_max_ = 0.0f;
-    for (float l : pixel_luminance_) l_max_ = std::max(l_max_, l);
+    const std::size_t n = pixel_leaf_.size();
+    if (all_dirty_) {
+      pixel_luminance_.resize(n);
+      lum_tree_.resize(2 * n);
+      exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = pixel_luminance_[p] = luminance(pixel_colour(p));
+      });
+      for (std::size_t i = n; i-- > 1;) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+      all_dirty_ = false;
+    } else {
+      for (std::uint32_t leaf : dirty_)
+        for (std::uint32_t p = leaf_head_[leaf]; p != invalid_id; p = pixel_next_[p]) {
+          pixel_luminance_[p] = luminance(pixel_colour(p));
+          std::size_t i = n + p;
+          lum_tree_[i] = pixel_luminance_[p];
+          for (i /= 2; i >= 1; i /= 2) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+        }
+    }
+    dirty_.clear();
+    if (++dirty_clock_ == 0) std::fill(dirty_mark_.begin(), dirty_mark_.end(), 0u), dirty_clock_ = 1;
+    l_max_ = n == 0 ? 0.0f : std::max(0.0f, lum_tree_[1]);
   }
 
   subdivision_mesh initial_mesh_, mesh_;
@@ -747,8 +976,27 @@ class progressive_refiner {
   std::vector<display_step> decision_;
   std::vector<std::uint32_t> decided_, shown_mark_;
   std::uint32_t display_clock_ = 0;
-  std::vector<std::uint8_t> ever_shown_;
-  std::size_t ever_shown_count_ = 0;
+  std::vector<std::uint32_t> leaf_head_;   // per triangle: first pixel of its list (visible leaves), else invalid_id
+  std::vector<std::uint32_t> pixel_next_;  // per pixel: the next pixel of its leaf's list
+  std::vector<std::uint32_t> fresh_;       // leaves that gained their first pixel
+  std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
+  std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
+  std::uint32_t dirty_clock_ = 1;
+  bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
+  std::vector<std::uint32_t> previous_shown_, shown_above_, merged_;
+  std::vector<std::uint32_t> shown_count_;  // per triangle: visible leaves showing it
+  struct waiter {
+    std::uint32_t triangle, next;
+  };
+  std::vector<waiter> waiters_;                            // the current view's waiting lists
+  std::vector<std::uint32_t> waiter_head_, waiter_clock_;  // per vertex: first waiter, its view's clock_
+  struct touched_triangle {
+    std::uint32_t triangle;
+    bool was;  // shown before this update
+  };
+  std::vector<touched_triangle> touched_;
+  std::vector<std::uint32_t> seeds_, stack_, added_, removed_;
+  std::size_t sent_total_ = 0;             // triangles that entered the shown set since the view was set
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
   std::vector<float> luminance_;
