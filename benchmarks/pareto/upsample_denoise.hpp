@@ -143,12 +143,15 @@ class atrous_filter {
         const float* __restrict qb = sb.data() + q0;
 #pragma omp simd
         for (std::ptrdiff_t x = x0; x < x1; ++x) {
-          float c = std::max(0.0f, pnx[x] * qnx[x] + pny[x] * qny[x] + pnz[x] * qnz[x]);
+          float c = pnx[x] * qnx[x] + pny[x] * qny[x] + pnz[x] * qnz[x];
+          c = 0.5f * (c + std::abs(c));  // max(c, 0) without a compare (one that may trap does not if-convert)
           c *= c, c *= c, c *= c, c *= c, c *= c, c *= c, c *= c;  // ^128
           const float t = std::abs(pz[x] - qz[x]) * tol[x] * inv_step;
-          float wz = std::max(0.0f, 1.0f - 0.25f * t);
+          float wz = 1.0f - 0.25f * t;
+          wz = 0.5f * (wz + std::abs(wz));
           wz *= wz, wz *= wz;
-          const float wt = pid[x] == qid[x] ? hk * c * wz : 0.0f;
+          const float same = static_cast<float>(pid[x] == qid[x]);  // a select, not a branch
+          const float wt = hk * c * wz * same;
           ws[x] += wt;
           oa[x] += wt * qa[x];
           ob[x] += wt * qb[x];
@@ -159,10 +162,10 @@ class atrous_filter {
     const float* __restrict cb = sb.data() + row;
 #pragma omp simd
     for (std::size_t x = 0; x < w_; ++x) {
-      const bool any = ws[x] > 0.0f;
-      const float inv = any ? 1.0f / ws[x] : 0.0f;
-      oa[x] = any ? oa[x] * inv : ca[x];
-      ob[x] = any ? ob[x] * inv : cb[x];
+      // No weight (a zero normal): the sums are 0 and the pixel keeps its value.
+      const float inv = 1.0f / (ws[x] + 1e-30f), none = static_cast<float>(ws[x] == 0.0f);
+      oa[x] = oa[x] * inv + none * ca[x];
+      ob[x] = ob[x] * inv + none * cb[x];
     }
   }
 
