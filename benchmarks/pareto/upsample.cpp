@@ -29,6 +29,9 @@
 //                     (rotated per pixel), 5 iterations of the edge-avoiding à-trous filter on the
 //                     two visibility planes (upsample_denoise.hpp); filter_seconds: the filter alone.
 //                     Then, per denoiser row, the best I-Buffer row within its time is printed.
+//   full_rotated      (with denoise_atrous) the reference's ray counts with the denoiser's rotated
+//                     ray sets, unfiltered: the distance of an equally converged image from the
+//                     reference's fixed ray sets, i.e. the best PSNR a denoiser can reach here
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
 // subset (the reference always runs), --match only the upsampler and joint-bilateral rows whose
 // setting contains TEXT (or one of TEXT|TEXT...). --diagnose prints where the I-Buffer's error and time go
@@ -650,6 +653,16 @@ class harness {
       const double mpix = 1e-6 * static_cast<double>(w_) * static_cast<double>(h_);
       std::printf("  per megapixel (wall): filter %.4f s, rays + shade %.4f s\n", filter / mpix, (t.wall - filter) / mpix);
     }
+    // The reference's ray counts with the denoiser's per-pixel rotated sets and no filter: how far
+    // an equally converged estimate with other rays lies from the reference's fixed sets (the
+    // PSNR a denoiser could reach at best against this reference).
+    infolerp::bench::denoise_renderer d(primary_sun, single_, shading_.ao_rays, shading_.soft_shadow_rays, w_, h_, 0, false);
+    sup::image img(w_, h_);
+    stopwatch t;
+    t.start();
+    d.render(img, infolerp::openmp_executor{threads_});
+    t.stop();
+    add("full_rotated", "the reference's ray counts, rays rotated per pixel, no filter", t, 1.0, img);
   }
 
   // For each denoiser row, the I-Buffer row (any mode) of the best PSNR that takes no more wall
@@ -698,7 +711,7 @@ class harness {
     // for a method left out by --only would shift every later title onto the wrong points).
     std::vector<const char*> methods;
     for (const char* m : {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer",
-                          "ibuffer_linear", "ibuffer_probe", "ibuffer_occl", "denoise_atrous"})
+                          "ibuffer_linear", "ibuffer_probe", "ibuffer_occl", "denoise_atrous", "full_rotated"})
       if (std::any_of(rows_.begin(), rows_.end(), [&](const auto& r) { return r.method == m; })) methods.push_back(m);
     for (const char* m : methods) {
       dat << "# " << m << "\n";
