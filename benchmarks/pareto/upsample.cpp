@@ -25,12 +25,19 @@
 //                     ratios differ pairwise by at most T (agree(), sample_source.hpp)
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
+//   denoise_atrous    what engines ship: primary + sun ray, n AO and m soft-shadow rays per pixel
+//                     (rotated per pixel), 5 iterations of the edge-avoiding à-trous filter on the
+//                     two visibility planes (upsample_denoise.hpp); filter_seconds: the filter alone.
+//                     Then, per denoiser row, the best I-Buffer row within its time is printed.
+//   full_rotated      (with denoise_atrous) the reference's ray counts with the denoiser's rotated
+//                     ray sets, unfiltered: the distance of an equally converged image from the
+//                     reference's fixed ray sets, i.e. the best PSNR a denoiser can reach here
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
 // subset (the reference always runs), --match only the upsampler and joint-bilateral rows whose
 // setting contains TEXT (or one of TEXT|TEXT...). --diagnose prints where the I-Buffer's error and time go
 // (feature clusters, 3 and 4 passes) instead of writing a CSV.
 // Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,
-// cpu_seconds,cpu_speedup_vs_full_single: wall and process CPU time, each the least of N runs)
+// cpu_seconds,cpu_speedup_vs_full_single,filter_seconds: wall and process CPU time, each the least of N runs)
 // and FILE.png: PSNR against CPU time (gnuplot), with FILE.gp/FILE.dat next to it. For CPU
 // times that mean something, run with OMP_WAIT_POLICY=passive (no spinning OpenMP workers).
 #include <algorithm>
@@ -51,6 +58,7 @@
 #include <omp.h>
 #include "infolerp/upsample/upsampler.hpp"
 #include "pareto.hpp"
+#include "upsample_denoise.hpp"
 #include "support/demo_clusters.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
@@ -99,6 +107,7 @@ std::vector<float> luma_of(const sup::image& img) {
 struct row {
   std::string method, setting;
   double seconds = 0, cpu_seconds = 0, evaluated_fraction = 0, psnr = 0, ssim = 0;
+  double filter_seconds = -1;  // denoise_atrous rows: the filter alone (least of the runs); -1: none
 };
 
 // The contrast competitor: the same pass schedule and record, but two samples may be
@@ -311,6 +320,9 @@ class harness {
     }
     // (4) joint-bilateral upsampling of the expensive terms from a 2^(p-1) grid.
     for (std::uint32_t passes = 2; passes <= 5 && want("joint_bilateral"); ++passes) joint_bilateral(1 << (passes - 1));
+    // (7) n AO + m soft-shadow rays per pixel and the edge-avoiding à-trous filter.
+    if (want("denoise_atrous")) denoise_atrous();
+    equal_time();
     return write(csv_path);
   }
 
@@ -615,15 +627,80 @@ class harness {
         (static_cast<double>(grid.size()) + static_cast<double>(fallbacks)) / (static_cast<double>(w_) * h_), img);
   }
 
+  // The denoiser baseline (upsample_denoise.hpp) for the (n, m) settings, 5 iterations;
+  // its time includes the rays, the filter and shade(); the filter alone is filter_seconds.
+  void denoise_atrous() {
+    sup::shader_options po = shading_;
+    po.ao_rays = 0;
+    po.soft_shadow_rays = 0;
+    const sup::reference_shader primary_sun(scene_, po);
+    for (const auto& [n, m] : {std::pair{1u, 1u}, {2u, 1u}, {4u, 1u}, {4u, 2u}, {8u, 2u}, {16u, 4u}}) {
+      char setting[96];
+      std::snprintf(setting, sizeof setting, "%u AO + %u soft rays, 5 iterations, object id", n, m);
+      if (!matches(setting)) continue;
+      infolerp::bench::denoise_renderer d(primary_sun, single_, n, m, w_, h_, 5);
+      sup::image img(w_, h_);
+      stopwatch t;
+      double filter = 1e30;
+      for (int rep = 0; rep < repeat_; ++rep) {
+        t.start();
+        const double f = d.render(img, infolerp::openmp_executor{threads_});
+        t.stop();
+        filter = std::min(filter, f);
+      }
+      add("denoise_atrous", setting, t, 0.0, img);
+      rows_.back().filter_seconds = filter;
+      const double mpix = 1e-6 * static_cast<double>(w_) * static_cast<double>(h_);
+      std::printf("  per megapixel (wall): filter %.4f s, rays + shade %.4f s\n", filter / mpix, (t.wall - filter) / mpix);
+    }
+    // The reference's ray counts with the denoiser's per-pixel rotated sets and no filter: how far
+    // an equally converged estimate with other rays lies from the reference's fixed sets (the
+    // PSNR a denoiser could reach at best against this reference).
+    infolerp::bench::denoise_renderer d(primary_sun, single_, shading_.ao_rays, shading_.soft_shadow_rays, w_, h_, 0, false);
+    sup::image img(w_, h_);
+    stopwatch t;
+    t.start();
+    d.render(img, infolerp::openmp_executor{threads_});
+    t.stop();
+    add("full_rotated", "the reference's ray counts, rays rotated per pixel, no filter", t, 1.0, img);
+  }
+
+  // For each denoiser row, the I-Buffer row (any mode) of the best PSNR that takes no more wall
+  // time, and the fastest I-Buffer row at >= its PSNR + 3 dB with higher SSIM.
+  void equal_time() const {
+    for (const auto& d : rows_) {
+      if (d.method != "denoise_atrous") continue;
+      const row *best = nullptr, *fastest_win = nullptr;
+      for (const auto& r : rows_) {
+        if (!r.method.starts_with("ibuffer")) continue;
+        if (r.seconds <= d.seconds && (best == nullptr || r.psnr > best->psnr)) best = &r;
+        if (r.psnr >= d.psnr + 3.0 && r.ssim > d.ssim && (fastest_win == nullptr || r.seconds < fastest_win->seconds)) fastest_win = &r;
+      }
+      std::printf("equal time: %s (%.3f s, %.2f dB, SSIM %.4f)\n", d.setting.c_str(), d.seconds, d.psnr, d.ssim);
+      if (best) std::printf("  best I-Buffer row within its time: %s %s (%.3f s, %.2f dB, SSIM %.4f): %s\n", best->method.c_str(),
+                            best->setting.c_str(), best->seconds, best->psnr, best->ssim,
+                            best->psnr >= d.psnr + 3.0 && best->ssim > d.ssim ? "beaten (+3 dB, higher SSIM)" : "NOT beaten");
+      else std::printf("  no I-Buffer row within its time\n");
+      if (fastest_win) std::printf("  fastest I-Buffer row at +3 dB and higher SSIM: %s %s (%.3f s, x%.2f of the denoiser's time)\n",
+                                   fastest_win->method.c_str(), fastest_win->setting.c_str(), fastest_win->seconds,
+                                   fastest_win->seconds / d.seconds);
+    }
+  }
+
   int write(const std::string& csv_path) {
     std::ofstream csv(csv_path);
     if (!csv) return fail("cannot write " + csv_path);
-    csv << "method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,cpu_seconds,cpu_speedup_vs_full_single\n";
+    csv << "method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,cpu_seconds,cpu_speedup_vs_full_single,filter_seconds\n";
     char line[512];
     for (const auto& r : rows_) {
-      std::snprintf(line, sizeof line, "%s,\"%s\",%.6f,%.4f,%.6f,%.4f,%.6f,%.6f,%.4f\n", r.method.c_str(), r.setting.c_str(),
+      std::snprintf(line, sizeof line, "%s,\"%s\",%.6f,%.4f,%.6f,%.4f,%.6f,%.6f,%.4f,", r.method.c_str(), r.setting.c_str(),
                     r.seconds, t_full_ / r.seconds, r.evaluated_fraction, r.psnr, r.ssim, r.cpu_seconds, cpu_full_ / r.cpu_seconds);
       csv << line;
+      if (r.filter_seconds >= 0) {
+        std::snprintf(line, sizeof line, "%.6f", r.filter_seconds);
+        csv << line;
+      }
+      csv << "\n";
     }
     csv.close();
     std::printf("wrote %s\n", csv_path.c_str());
@@ -634,7 +711,7 @@ class harness {
     // for a method left out by --only would shift every later title onto the wrong points).
     std::vector<const char*> methods;
     for (const char* m : {"full_single", "full_packets16", "lowres_bilinear", "joint_bilateral", "contrast", "ibuffer",
-                          "ibuffer_linear", "ibuffer_probe", "ibuffer_occl"})
+                          "ibuffer_linear", "ibuffer_probe", "ibuffer_occl", "denoise_atrous", "full_rotated"})
       if (std::any_of(rows_.begin(), rows_.end(), [&](const auto& r) { return r.method == m; })) methods.push_back(m);
     for (const char* m : methods) {
       dat << "# " << m << "\n";

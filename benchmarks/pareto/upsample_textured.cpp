@@ -1,5 +1,5 @@
 // infolerp_pareto upsample --textured DIR [--size W H] [--repeat N] [--threads N] [--ao N] [--soft N]
-//                                         [--pictures OUT]
+//                                         [--pictures OUT] [--csv FILE]
 //
 // The I-Buffer with the library's ready sample source (upsample/ray_cast_source.hpp) on a
 // textured asset loaded from disk, against per-pixel evaluation with the same source, in one
@@ -18,10 +18,14 @@
 //   ibuffer_refine   the ready source with refined probes (primary ray per pixel, hard shadow where
 //                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1
 //   *_hand           the hand-written source in the same setting (the ready source's cost ratio)
+//   denoise_atrous   n AO + m soft-shadow rays per pixel and the edge-avoiding à-trous filter
+//                    (upsample_denoise.hpp); --csv FILE appends every row of both scenes to FILE,
+//                    with the filter's own time as filter_seconds
 // PSNR (display values) and SSIM (display luma) are against per_pixel's image. With --pictures,
 // OUT/reference.png, OUT/ibuffer.png (the fastest row with >= 40 dB and SSIM >= 0.98, else the
 // best PSNR) and OUT/clusters.png (cluster ids, boundaries dark, texture-chart seams white),
-// cropped to at most 272x272 pixels at the asset's centre.
+// cropped to at most 272x272 pixels at the asset's centre, and OUT/upsample_vs_denoiser.png: the
+// cheapest denoise_atrous frame (left) beside the best-PSNR I-Buffer frame that took no more time.
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -36,6 +40,7 @@
 #include <omp.h>
 #include "infolerp/upsample/upsampler.hpp"
 #include "pareto.hpp"
+#include "upsample_denoise.hpp"
 #include "support/demo_clusters.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
@@ -50,7 +55,7 @@ namespace sup = infolerp::support;
 using sample = sup::demo_sample;
 
 struct textured_options {
-  std::filesystem::path dir, pictures;
+  std::filesystem::path dir, pictures, csv;
   int width = 1025, height = 1025, repeat = 5, threads = 0, ao = 64, soft = 16;
 };
 
@@ -62,6 +67,7 @@ struct row {
   std::vector<double> cpu{};      // process CPU time per repetition (all threads)
   double evaluated = 1.0, psnr = 0.0, ssim = 0.0;
   sup::image img{};
+  std::shared_ptr<double> filter{};  // denoise_atrous rows: the least filter time of the repetitions
   static double min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
   static double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -109,6 +115,17 @@ std::function<double(sup::image&)> ibuffer(const Source& src, std::uint32_t pass
       std::exit(1);
     }
     return shared->stats().evaluated_fraction();
+  };
+}
+
+// n AO + m soft-shadow rays per pixel and the à-trous filter (upsample_denoise.hpp); the
+// filter's least time goes to *filter.
+std::function<double(sup::image&)> denoise(const sup::reference_shader& primary_sun, const sup::reference_shader& shader, unsigned n,
+                                           unsigned m, int threads, int w, int h, const std::shared_ptr<double>& filter) {
+  auto d = std::make_shared<infolerp::bench::denoise_renderer>(primary_sun, shader, n, m, w, h, 5);
+  return [d, threads, filter](sup::image& img) {
+    *filter = std::min(*filter, d->render(img, infolerp::openmp_executor{threads}));
+    return 0.0;
   };
 }
 
@@ -165,6 +182,26 @@ void print(const std::string& scene, const std::vector<row>& rows) {
                     median_ratio(ready.seconds, hand.seconds), row::min(ready.cpu) / row::min(hand.cpu), median_ratio(ready.cpu, hand.cpu));
   }
   std::fflush(stdout);
+}
+
+// Appends the rows to FILE (the header first when FILE is new): wall and CPU times are the
+// least of the repetitions, speed-ups against per_pixel; filter_seconds only for the denoiser.
+void append_csv(const std::filesystem::path& path, const std::string& scene, const std::vector<row>& rows) {
+  const bool fresh = !std::filesystem::exists(path);
+  std::FILE* f = std::fopen(path.string().c_str(), "a");
+  if (f == nullptr) {
+    std::fprintf(stderr, "infolerp_pareto upsample: cannot write %s\n", path.string().c_str());
+    return;
+  }
+  if (fresh) std::fprintf(f, "scene,method,setting,seconds,seconds_median,speedup_vs_per_pixel,evaluated_fraction,psnr_db,ssim,cpu_seconds,filter_seconds\n");
+  for (const auto& r : rows) {
+    std::fprintf(f, "\"%s\",%s,\"%s\",%.6f,%.6f,%.4f,%.6f,%.4f,%.6f,%.6f,", scene.c_str(), r.method.c_str(), r.setting.c_str(), r.min(),
+                 r.median(), rows[0].min() / r.min(), r.evaluated, std::min(r.psnr, 99.0), r.ssim, row::min(r.cpu));
+    if (r.filter) std::fprintf(f, "%.6f", *r.filter);
+    std::fprintf(f, "\n");
+  }
+  std::fclose(f);
+  std::printf("appended %zu rows to %s\n", rows.size(), path.string().c_str());
 }
 
 glm::vec3 id_colour(std::uint32_t k) {
@@ -239,6 +276,25 @@ void write_pictures(const textured_options& o, const sup::demo_scene& scene, con
     save(best->img, "ibuffer.png");
   }
   save(img, "clusters.png");
+  // The cheapest denoiser row beside the best-PSNR I-Buffer row that took no more time (min wall).
+  const row* denoised = nullptr;
+  for (const auto& r : rows)
+    if (r.method == "denoise_atrous" && (denoised == nullptr || r.min() < denoised->min())) denoised = &r;
+  const row* equal = nullptr;
+  for (const auto& r : rows)
+    if (denoised != nullptr && (r.method == "ibuffer" || r.method == "ibuffer_refine") && r.min() <= denoised->min() &&
+        (equal == nullptr || r.psnr > equal->psnr))
+      equal = &r;
+  if (equal == nullptr) return;
+  std::printf("upsample_vs_denoiser.png: left %s %s (%.3f s, %.2f dB), right %s %s (%.3f s, %.2f dB)\n", denoised->setting.c_str(),
+              denoised->method.c_str(), denoised->min(), denoised->psnr, equal->method.c_str(), equal->setting.c_str(), equal->min(), equal->psnr);
+  const sup::image a = crop(denoised->img, x0, y0, x1, y1), b = crop(equal->img, x0, y0, x1, y1);
+  sup::image both(2 * a.width + 4, a.height);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) both.at(x, y) = a.at(x, y), both.at(a.width + 4 + x, y) = b.at(x, y);
+  const auto path = (o.pictures / "upsample_vs_denoiser.png").string();
+  if (auto st = sup::write_png(both, path); !st) std::fprintf(stderr, "%s\n", st.message().c_str());
+  else std::printf("wrote %s\n", path.c_str());
 }
 
 // The rows of one scene: per-pixel (ready, hand-written), the I-Buffer plain and with refined
@@ -280,8 +336,15 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
     rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src", ibuffer(*refine, p, 1, o.threads, o.width, o.height), {}});
   rows.push_back({"ibuffer_hand", "4 passes", ibuffer(hand, 4, 2, o.threads, o.width, o.height), {}});
   rows.push_back({"ibuffer_refine_hand", "5 passes, min 1 src", ibuffer(hand_refine, 5, 1, o.threads, o.width, o.height), {}});
+  for (const auto& [n, m] : {std::pair{1u, 1u}, {2u, 1u}, {4u, 1u}, {4u, 2u}, {8u, 2u}, {16u, 4u}}) {
+    auto filter = std::make_shared<double>(1e30);
+    rows.push_back({"denoise_atrous", std::to_string(n) + " AO + " + std::to_string(m) + " soft rays, 5 iterations",
+                    denoise(primary_sun, shader, n, m, o.threads, o.width, o.height, filter), {}});
+    rows.back().filter = filter;
+  }
   measure(rows, o.repeat, o.width, o.height);
   print(title, rows);
+  if (!o.csv.empty()) append_csv(o.csv, title, rows);
   if (asset != nullptr && !o.pictures.empty()) write_pictures(o, scene, *asset, first, clusters, rows);
   return 0;
 }
@@ -296,13 +359,14 @@ int pareto_upsample_textured(int argc, char** argv) {
     auto num = [&](int k) { return std::atoi(argv[i + k]); };
     if (a == "--textured" && has1) o.dir = argv[++i];
     else if (a == "--pictures" && has1) o.pictures = argv[++i];
+    else if (a == "--csv" && has1) o.csv = argv[++i];
     else if (a == "--size" && has2) o.width = num(1), o.height = num(2), i += 2;
     else if (a == "--repeat" && has1) o.repeat = num(1), ++i;
     else if (a == "--threads" && has1) o.threads = num(1), ++i;
     else if (a == "--ao" && has1) o.ao = num(1), ++i;
     else if (a == "--soft" && has1) o.soft = num(1), ++i;
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample --textured DIR [--size W H] [--repeat N] [--threads N] [--ao N] [--soft N] [--pictures OUT]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample --textured DIR [--size W H] [--repeat N] [--threads N] [--ao N] [--soft N] [--pictures OUT] [--csv FILE]\n");
       return 2;
     }
   }
