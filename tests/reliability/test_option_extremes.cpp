@@ -635,6 +635,11 @@ TEST_CASE("ray_cast_source: view vectors, normals, texcoords and barycentrics at
   const float nan_f = std::numeric_limits<float>::quiet_NaN();
   CHECK(run_ray_cast(sphere(), {.view_forward = {nan_f, 0.0f, -1.0f}}).st.code() == errc::bad_parameter);
   CHECK(run_ray_cast(sphere(), {.view_origin = {0.0f, nan_f, 0.0f}}).st.code() == errc::bad_parameter);
+  // A view depth that overflows float gave inv_depth 0, and the upsampler's weights 0/0.
+  const outcome far_view = run_ray_cast(sphere(), {.ao_rays = 4, .view_origin = {0.0f, 0.0f, -3e38f},
+                                                   .view_forward = {0.0f, 0.0f, 2.0f}});
+  CHECK(far_view.st.ok());
+  CHECK(far_view.output_ok);
   indexed_mesh m = sphere_with_normals();
   CHECK(run_ray_cast(m, {.ao_rays = 4}).output_ok);
   for (auto& n : m.normals) n = glm::vec3(0.0f);  // zero normals: the geometric normal shades
@@ -728,4 +733,16 @@ TEST_CASE("a negative weight or saliency is a bad parameter, a NaN one non-finit
   s[6] = -1.0;
   CHECK(salient_clustering(sphere(), s).error().code() == errc::bad_parameter);
   CHECK(weighting_map(sphere(), s, halves(sphere()), 2).error().code() == errc::bad_parameter);
+}
+
+TEST_CASE("subdivision: two triangles on the same three vertices are refused, not split", "[reliability][options]") {
+  // A closed two-triangle pillow passes validate_mesh (every edge has two faces), but splitting
+  // one gave the shared midpoints' inner edges four faces (an assertion in the refiner's run).
+  indexed_mesh pillow;
+  pillow.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  pillow.triangles = {{0, 1, 2}, {0, 2, 1}};
+  auto s = subdivision_mesh::create(pillow);
+  REQUIRE_FALSE(s.ok());
+  CHECK(s.error().code() == errc::non_manifold_edge);
+  CHECK(s.error().message().find("triangles 0 and 1") != std::string::npos);
 }

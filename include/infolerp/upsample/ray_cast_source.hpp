@@ -248,8 +248,13 @@ class ray_cast_source {
         s.texcoord = w * mesh_traits<M>::texcoord(m, h.triangle, 0) + u * mesh_traits<M>::texcoord(m, h.triangle, 1) +
                      v * mesh_traits<M>::texcoord(m, h.triangle, 2);
     }
-    if (options_.view_forward != glm::vec3(0.0f))
-      s.inv_depth = 1.0f / std::max(glm::dot(s.position - options_.view_origin, options_.view_forward), 1e-6f);
+    // Depth clamped to [1e-6, 1/FLT_MIN], NaN (an overflowing difference) counting as far: inv_depth
+    // stays a normal positive float, so the upsampler's sums of inv_depth invert to finite weights.
+    if (options_.view_forward != glm::vec3(0.0f)) {
+      constexpr float far = 1.0f / std::numeric_limits<float>::min();
+      const float depth = glm::dot(s.position - options_.view_origin, options_.view_forward);
+      s.inv_depth = 1.0f / std::clamp(std::isnan(depth) ? far : depth, 1e-6f, far);
+    }
   }
 
   // d normalised, or fallback when d has no direction a float can hold.
