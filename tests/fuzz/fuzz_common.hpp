@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <vector>
 #include "infolerp/core/status.hpp"
 #include "infolerp/mesh/adaptors.hpp"
@@ -58,6 +59,36 @@ struct reader {
   double unit() {
     const std::uint8_t s = u8();
     return s == 255 ? take<double>() : static_cast<double>(s) / 254.0;
+  }
+  // An option value of type double: a small value on a 1/32 grid in [-2, 5.97] (most in range),
+  // one of the extremes after a 254 marker (NaN, ±Inf, ±max, the smallest subnormal, -0), or raw
+  // double bits after a 255 marker.
+  double real() {
+    const std::uint8_t s = u8();
+    if (s == 255) return take<double>();
+    if (s == 254) {
+      constexpr double lim[7] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                                 -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::max(),
+                                 std::numeric_limits<double>::lowest(), std::numeric_limits<double>::denorm_min(), -0.0};
+      return lim[u8() % 7];
+    }
+    return (static_cast<double>(s) - 64.0) / 32.0;
+  }
+  float real_f() {  // the same for a float member (saturated to ±Inf)
+    const double x = real();
+    if (std::isnan(x)) return std::numeric_limits<float>::quiet_NaN();
+    if (x > std::numeric_limits<float>::max()) return std::numeric_limits<float>::infinity();
+    if (x < std::numeric_limits<float>::lowest()) return -std::numeric_limits<float>::infinity();
+    return static_cast<float>(x);
+  }
+  // A count option of unsigned type T: small values (0..253), the type's largest after 254, raw
+  // bits after 255.
+  template <class T>
+  T count() {
+    const std::uint8_t s = u8();
+    if (s == 255) return take<T>();
+    if (s == 254) return std::numeric_limits<T>::max();
+    return static_cast<T>(s);
   }
 };
 

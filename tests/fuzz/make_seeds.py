@@ -97,3 +97,76 @@ write("fuzz_lod", "octahedron_uniform_global", bytes([4 | 8 | 16 | 0x40, 0, 1]) 
       bytes([0, 1] * 4) + bytes([3, 4]))
 write("fuzz_lod", "plane_boundary", bytes([4, 0, 1]) + mesh(PLANE_V, PLANE_T) + bytes([t // 9 for t in range(18)]) +
       bytes([6, 7]))
+
+# Options targets: option values through reader::real() (byte s: (s - 64) / 32; 254 + k: the k-th
+# extreme; 255 + 8 bytes: raw double) and reader::count<T>() (byte s: s; 254: the type's largest).
+def r(v):  # a real option on the 1/32 grid
+    return bytes([int(round(v * 32)) + 64])
+
+
+EXTREME_NAN, EXTREME_INF, EXTREME_MAX = bytes([254, 0]), bytes([254, 1]), bytes([254, 3])
+COUNT_MAX = bytes([254])
+
+# fuzz_options_cluster: [flags][min fraction][grain][vis: threshold viewpoints samples radius grain
+# probes resolution min-pixels][ori: threshold bins exact][str: threshold bins exact theta][mesh][uvs]
+write("fuzz_options_cluster", "visibility_orientation", bytes([0x05]) + r(0) + bytes([32]) +
+      r(0.5) + bytes([8, 2]) + r(1) + bytes([64, 0, 16]) + r(4) + r(0.03) + bytes([64, 0]) + r(0.1) + bytes([32, 0]) +
+      r(1) + mesh(OCTA_V, OCTA_T))
+write("fuzz_options_cluster", "stretch_uv", bytes([0xC1]) + r(0.01) + bytes([3]) + r(0.5) + bytes([8, 2]) + r(1) +
+      bytes([64, 0, 16]) + r(4) + r(0.03) + bytes([0, 1]) + r(0.1) + bytes([16, 1]) + r(1) + mesh(ICO_V, ICO_T) + UV)
+write("fuzz_options_cluster", "extremes", bytes([0x25]) + r(0) + COUNT_MAX + r(0.5) + COUNT_MAX + bytes([2]) + r(1) +
+      COUNT_MAX + COUNT_MAX + COUNT_MAX + EXTREME_INF + r(0.03) + COUNT_MAX + bytes([0]) + r(0.1) + COUNT_MAX +
+      bytes([0]) + EXTREME_MAX + mesh(OCTA_V, OCTA_T))
+
+# fuzz_options_saliency: [flags][epsilon][flat threshold][grain][scale count][scales][clusters][pool]
+# [normal weight][seed][iterations][camera x3][lambda][target][mesh][capacities]
+write("fuzz_options_saliency", "defaults_icosahedron", bytes([1]) + r(0.1) + r(0) + bytes([1, 0]) + bytes([3]) +
+      r(5) + r(1) + bytes([1, 50]) + r(0.5) + r(0.5) + r(4) + r(0.03) + bytes([20]) + mesh(ICO_V, ICO_T) +
+      bytes([9, 9, 9]))
+write("fuzz_options_saliency", "own_scales", bytes([2]) + r(0.25) + r(0.01) + bytes([3, 2]) + r(1) + r(2) +
+      bytes([2]) + r(2) + r(1) + bytes([7, 3]) + r(0) + r(0) + r(3) + r(1) + bytes([5]) + mesh(OCTA_V, OCTA_T) +
+      bytes([4, 4]))
+write("fuzz_options_saliency", "extremes", bytes([1]) + EXTREME_NAN + r(0) + COUNT_MAX + bytes([0]) + COUNT_MAX +
+      EXTREME_MAX + EXTREME_INF + COUNT_MAX + COUNT_MAX + EXTREME_MAX + r(0) + r(4) + bytes([254, 5]) + COUNT_MAX +
+      mesh(ICO_V, ICO_T) + bytes([200] * 4))
+
+# fuzz_options_lod: [flags][epsilon][smoothing][percentile / 20][amplification][grain][backstop]
+# [boundary weight][min normal cos][lambda][grain][camera x3][contractions][clusters - 1][mesh]
+# [saliency per vertex][cluster per triangle]
+write("fuzz_options_lod", "icosahedron_two_clusters", bytes([1]) + r(0.1) + r(3) + r(1.5) + r(1) + bytes([1]) +
+      r(0) + r(2) + r(0) + r(0.03) + bytes([3]) + r(0.5) + r(-1) + r(5) + bytes([6, 1]) + mesh(ICO_V, ICO_T) +
+      bytes([(37 * k) % 254 for k in range(12)]) + bytes([t % 2 for t in range(20)]))
+write("fuzz_options_lod", "extremes", bytes([3]) + EXTREME_MAX + EXTREME_MAX + r(5) + EXTREME_MAX + COUNT_MAX +
+      r(1) + EXTREME_INF + r(0.99) + r(1) + COUNT_MAX + EXTREME_MAX + r(0) + r(0) + COUNT_MAX + bytes([0]) +
+      mesh(OCTA_V, OCTA_T) + EXTREME_MAX * 6 + bytes([0] * 8))
+
+# fuzz_options_refine: [flags][bisect][depth][criterion][s_req][min pixels][always][batch][rnd fraction]
+# [nld_is fraction][random share][seed][max samples][max batches][max cached][background][grain]
+# [eye x3][target x3][up x3][fov if flags & 1][width][height][hit: geometry triangle u v distance][mesh]
+refine_head = (bytes([0]) + r(0.5) + bytes([1, 0]) + r(0.05) + r(2) + r(0.03) + bytes([16, 127]) + r(1) + r(0) +
+               bytes([1]) + COUNT_MAX + bytes([6]) + COUNT_MAX + r(0) + bytes([64]))
+camera_part = r(0.2) + r(-0.3) + r(-0.5) + r(0) + r(0) + r(0) + r(0) + r(1) + r(0) + bytes([12, 10])
+write("fuzz_options_refine", "nld_os_plane", refine_head + camera_part + bytes([0, 0]) + r(0.25) + r(0.25) + r(1) +
+      mesh(PLANE_V, PLANE_T))
+write("fuzz_options_refine", "wild_hits", bytes([2]) + refine_head[1:] + camera_part + bytes([0, 3]) +
+      bytes([255]) + struct.pack("<d", 1e38) + bytes([255]) + struct.pack("<d", -1e38) + r(1) + mesh(PLANE_V, PLANE_T))
+write("fuzz_options_refine", "far_camera", bytes([1]) + refine_head[1:] + bytes([255]) + struct.pack("<d", 3e19) +
+      r(0) + r(0) + r(0) + r(0) + r(0) + r(0) + r(1) + r(0) + EXTREME_MAX + bytes([8, 8, 0, 0]) + r(0.2) + r(0.2) +
+      r(1) + mesh(PLANE_V, PLANE_T))
+
+# fuzz_options_upsample: [flags][w][h][passes][max passes][rows][min sources][controller: min max
+# max-passes initial smoothing settle forget][8 frame times][ao rays][ao radius][offset][lights if 4]
+# [soft points if 8][soft normal x3][view origin x3][view forward x3][tolerance][hit: triangle u v
+# distance][mesh][normals if 32][texcoords if 64]
+up_head = (bytes([24, 23, 3, 3, 2, 2]) + r(0.5) + r(1) + bytes([4, 1]) + r(0.25) + bytes([2, 30]) +
+           b"".join(r(v) for v in [0.25, 0.5, 2, 1.5, 0.1, 0.1, 1, 0]))
+rc_tail = (bytes([8]) + r(1.5) + r(0.01) + r(0) + r(0) + r(-1) + r(0) + r(0) + r(0) + r(0) + r(0) + r(-1) + EXTREME_INF +
+           bytes([5]) + r(0.2) + r(0.2) + r(1))
+write("fuzz_options_upsample", "icosahedron", bytes([0x01]) + up_head + rc_tail + mesh(ICO_V, ICO_T))
+write("fuzz_options_upsample", "normals_uvs", bytes([0x61]) + up_head + rc_tail + mesh(OCTA_V, OCTA_T) +
+      b"".join(r(x) for p in OCTA_V for x in p) + bytes([0]) + r(0.5) * 48)
+write("fuzz_options_upsample", "extremes", bytes([0x8E]) + COUNT_MAX + COUNT_MAX + COUNT_MAX + COUNT_MAX +
+      COUNT_MAX + COUNT_MAX + EXTREME_NAN + EXTREME_MAX + COUNT_MAX + COUNT_MAX + EXTREME_INF + COUNT_MAX +
+      COUNT_MAX + EXTREME_MAX * 8 + COUNT_MAX + EXTREME_MAX + EXTREME_INF + r(1) * 12 + r(0) * 9 + EXTREME_NAN +
+      bytes([1]) + bytes([255]) + struct.pack("<d", 1e38) + bytes([255]) + struct.pack("<d", -1e38) + r(1) +
+      mesh(OCTA_V, OCTA_T))

@@ -413,6 +413,8 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   CHECK(s.element() == 3);
   std::vector<double> w(3 * m.triangle_count(), 1.0);
   w[5] = -1.0;
+  CHECK(make_contraction_hierarchy(m, w, cl, 8).error().code() == errc::bad_parameter);  // finite but negative
+  w[5] = std::numeric_limits<double>::infinity();
   CHECK(make_contraction_hierarchy(m, w, cl, 8).error().code() == errc::non_finite);
   w[5] = std::nan("");
   CHECK(make_contraction_hierarchy(m, w, cl, 8).error().element() == 5);
@@ -420,7 +422,7 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   CHECK(make_contraction_hierarchy(m, w, cl, 8).error().code() == errc::bad_size);
   std::vector<double> bad_sal = sal;
   bad_sal[2] = -0.5;
-  CHECK(weighting_map(m, bad_sal, cl, 8).error().code() == errc::non_finite);
+  CHECK(weighting_map(m, bad_sal, cl, 8).error().code() == errc::bad_parameter);  // finite but negative
   CHECK(weighting_map(m, sal, cl, 8, {.amplify_percentile = 101.0}).error().code() == errc::bad_parameter);
 }
 

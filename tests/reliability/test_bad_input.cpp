@@ -457,7 +457,7 @@ TEST_CASE("bad-input matrix: saliency and clustering options and per-vertex data
   bad[3] = nan_d;
   check_cell("NaN per-vertex value", "salient_clustering", clus(bad, {}), {errc::non_finite, "vertex 3"});
   bad[3] = -1.0;
-  check_cell("negative per-vertex value", "salient_clustering", clus(bad, {}), {errc::non_finite, "vertex 3"});
+  check_cell("negative per-vertex value", "salient_clustering", clus(bad, {}), {errc::bad_parameter, "vertex 3"});
 
   std::vector<std::uint32_t> cluster(nt, 0);
   cluster[2] = 5;

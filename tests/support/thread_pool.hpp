@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <thread>
 #include <vector>
+#include "infolerp/core/executor.hpp"
 
 namespace infolerp::support {
 
@@ -16,13 +17,14 @@ class thread_pool_executor {
   template <class F>
   void parallel_for(std::size_t n, std::size_t grain, F&& fn) const {
     if (n == 0) return;
-    grain = std::max<std::size_t>(grain, 1);
+    const std::size_t chunks = chunk_count(n, grain);  // chunk indices, so no grain can wrap a bound
     std::atomic<std::size_t> next{0};
     auto work = [&] {
       for (;;) {
-        const std::size_t begin = next.fetch_add(grain);
-        if (begin >= n) return;
-        fn(begin, std::min(n, begin + grain));
+        const std::size_t c = next.fetch_add(1);
+        if (c >= chunks) return;
+        const chunk_bounds r = chunk_at(n, grain, c);
+        fn(r.begin, r.end);
       }
     };
     std::vector<std::thread> threads;

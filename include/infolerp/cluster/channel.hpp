@@ -97,6 +97,33 @@ inline status check_threshold(double threshold, const char* what) {
 // exactly 1 for disjoint rows, and the paper wants Th = 1 to give one cluster).
 inline bool is_similar(double js, double threshold) noexcept { return threshold >= 1.0 || js < threshold; }
 
+namespace detail {
+// Binned channels: the occupied cells of `cells` possible ones, numbered in ascending cell order.
+// id[i] = the number of the element i's cell; returns the occupied count. A direct table when
+// cells <= 4·M + 4096, otherwise a sort of the M cell numbers, so memory follows the cells in
+// use and never the option value: O(M + min(cells, 4·M + 4096)) time (O(M log M) when sorting),
+// allocation O(M + min(cells, 4·M + 4096)).
+inline std::uint32_t number_occupied_cells(std::span<const std::uint32_t> cell, std::size_t cells,
+                                           std::vector<std::uint32_t>& id) {
+  id.resize(cell.size());
+  std::uint32_t u = 0;
+  if (cells <= 4 * cell.size() + 4096) {
+    std::vector<std::uint32_t> number(cells, invalid_id);
+    for (std::uint32_t c : cell) number[c] = 0;
+    for (auto& c : number)
+      if (c != invalid_id) c = u++;
+    for (std::size_t i = 0; i < cell.size(); ++i) id[i] = number[cell[i]];
+    return u;
+  }
+  std::vector<std::uint32_t> used(cell.begin(), cell.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  for (std::size_t i = 0; i < cell.size(); ++i)
+    id[i] = static_cast<std::uint32_t>(std::lower_bound(used.begin(), used.end(), cell[i]) - used.begin());
+  return static_cast<std::uint32_t>(used.size());
+}
+}  // namespace detail
+
 // A direct channel (T→T) aggregated over classes. Rows are asked per row class a (elements
 // with identical rows); their entries are per column c, a group of output elements:
 //   row_a(c) = mass(a, c) / Σ_c' mass(a, c')      (mass = summed kernel over c's elements)

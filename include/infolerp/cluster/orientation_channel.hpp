@@ -82,7 +82,9 @@ inline std::uint32_t octahedral_cell(glm::vec3 n, std::uint32_t r) {
 // cell's mean normal stands for its elements); exact_rows = true: every distinct normal keeps
 // its own row over the cells (U rows of C entries).
 // Preconditions: normals unit or (0,0,0). Complexity O(M log M) with exact classes, O(M + K)
-// per-cell rows (+ the O(U·C) output distribution). Allocation O(M + U + C).
+// per-cell rows (O(M log M) when K > 4·M + 4096) (+ the O(U·C) output distribution).
+// Allocation O(M + U + C + min(K, 4·M + 4096)): any K, up to 2^32 − 1, sizes nothing beyond the
+// cells in use (channel.hpp, number_occupied_cells).
 inline orientation_state make_orientation_state(std::span<const glm::vec3> normals, std::uint32_t bins,
                                                 bool exact_rows = false) {
   const std::size_t m = normals.size();
@@ -111,24 +113,18 @@ inline orientation_state make_orientation_state(std::span<const glm::vec3> norma
   }
   if (bins > 0) {
     const auto r = std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::sqrt(double(bins))));
-    std::vector<std::uint32_t> cell_column(std::size_t{r} * r + 1, invalid_id);
-    std::vector<std::uint32_t> cell(m);
-    for (std::size_t i = 0; i < m; ++i) {
-      cell[i] = octahedral_cell(normals[i], r);
-      cell_column[cell[i]] = 0;
-    }
-    std::uint32_t u = 0;
-    for (auto& c : cell_column)
-      if (c != invalid_id) c = u++;
+    std::vector<std::uint32_t> cell(m), column;
+    for (std::size_t i = 0; i < m; ++i) cell[i] = octahedral_cell(normals[i], r);
+    const std::uint32_t u = detail::number_occupied_cells(cell, std::size_t{r} * r + 1, column);
     k.column_counts.assign(u, 0.0);
     k.column_sums.assign(u, glm::dvec3(0.0));
     for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t c = cell_column[cell[i]];
+      const std::uint32_t c = column[i];
       k.column_counts[c] += 1.0;
       k.column_sums[c] += glm::dvec3(normals[i]);
     }
     if (!exact_rows) {
-      for (std::size_t i = 0; i < m; ++i) class_of[i] = cell_column[cell[i]];
+      class_of = std::move(column);
       k.counts = k.column_counts;
       k.reps.resize(u);
       for (std::uint32_t c = 0; c < u; ++c) {
@@ -166,7 +162,8 @@ struct prepared_orientation_channel {
 // User-facing options (Algorithm 1 takes it directly, e.g. orientation_channel{.threshold = 0.02}).
 struct orientation_channel {
   double threshold = 0.02;  // JS threshold Th in [0,1]: 0 = one cluster per triangle, 1 = one cluster
-  std::uint32_t bins = 1024;  // K octahedral cells (rounded down to a square); 0 = exact rows
+  std::uint32_t bins = 1024;  // K octahedral cells (rounded down to a square); 0 = exact rows. Any
+                              // K is valid: memory follows the occupied cells (<= triangles), not K
   bool exact_rows = false;    // with bins > 0: each distinct normal keeps its own row over the cells
 
   // Computes the face normals. Complexity O(T), allocation T normals. Never fails for a valid mesh.

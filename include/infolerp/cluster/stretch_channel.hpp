@@ -147,8 +147,8 @@ using stretch_state = direct_channel_state<stretch_kernel>;
 // the occupied ones of K equal cells over [0, 1]; exact_rows = false: the rows are per cell too
 // (the cell's mean value stands for its elements); exact_rows = true: every distinct value keeps
 // its own row over the cells, with masses exact by prefix sums (U rows of C entries).
-// Complexity O(M log M) with exact classes, O(M + K) per-cell rows (+ the O(U·C) output
-// distribution). Allocation O(M + U + C).
+// Complexity O(M log M) with exact classes, O(M + K) per-cell rows (O(M log M) when K > 4·M +
+// 4096) (+ the O(U·C) output distribution). Allocation O(M + U + C + min(K, 4·M + 4096)).
 inline stretch_state make_stretch_state(std::span<const double> raw, std::uint32_t bins, bool exact_rows = false) {
   const std::size_t m = raw.size();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -177,18 +177,12 @@ inline stretch_state make_stretch_state(std::span<const double> raw, std::uint32
       k.counts.back() += 1.0;
     }
   } else {
-    std::vector<std::uint32_t> cell(m), cell_class(bins, invalid_id);
-    for (std::size_t i = 0; i < m; ++i) {
-      cell[i] = cell_of(s[i]);
-      cell_class[cell[i]] = 0;
-    }
-    std::uint32_t u = 0;
-    for (auto& c : cell_class)
-      if (c != invalid_id) c = u++;
+    std::vector<std::uint32_t> cell(m);
+    for (std::size_t i = 0; i < m; ++i) cell[i] = cell_of(s[i]);
+    const std::uint32_t u = detail::number_occupied_cells(cell, bins, class_of);
     k.counts.assign(u, 0.0);
     k.reps.assign(u, 0.0);
     for (std::size_t i = 0; i < m; ++i) {
-      class_of[i] = cell_class[cell[i]];
       k.counts[class_of[i]] += 1.0;
       k.reps[class_of[i]] += s[i];
     }
@@ -244,7 +238,8 @@ struct prepared_stretch_channel {
 
 struct stretch_channel {
   double threshold = 0.1;     // JS threshold Th in [0,1]
-  std::uint32_t bins = 1024;  // K cells over the normalised stretch; 0 = exact rows
+  std::uint32_t bins = 1024;  // K cells over the normalised stretch; 0 = exact rows. Any K is valid:
+                              // memory follows the occupied cells (<= triangles), not K
   bool exact_rows = false;    // with bins > 0: each distinct value keeps its own row over the cells
   double theta = 1.0;         // Degener's area-distortion exponent θ >= 0
 

@@ -46,6 +46,28 @@ struct serial_executor {
   }
 };
 
+// Fixed chunking, the one place that turns (n, grain) into ranges: every chunked loop of the
+// library (and an executor that splits by grain) goes through these, so no grain, however large,
+// can wrap a chunk bound. Grain 0 counts as 1; a grain above n gives one chunk. O(1), no
+// allocation.
+// Number of fixed chunks of `grain` elements covering n elements.
+constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
+  grain = grain == 0 ? 1 : grain;
+  return n / grain + (n % grain != 0 ? 1 : 0);
+}
+
+struct chunk_bounds {
+  std::size_t begin = 0, end = 0;
+};
+
+// Chunk c: [c·grain, min(n, (c+1)·grain)), computed without overflow. Precondition:
+// c < chunk_count(n, grain) (then c·grain < n).
+constexpr chunk_bounds chunk_at(std::size_t n, std::size_t grain, std::size_t c) noexcept {
+  grain = grain == 0 ? 1 : grain;
+  const std::size_t begin = c * grain;
+  return {begin, begin + std::min(grain, n - begin)};
+}
+
 #ifdef _OPENMP
 // OpenMP worksharing over chunks of `grain` (dynamic schedule). Offered only when the
 // translation unit is compiled with OpenMP. threads = 0 uses OpenMP's default.
@@ -56,23 +78,16 @@ struct openmp_executor {
   template <class F>
   void parallel_for(std::size_t n, std::size_t grain, F&& fn) const {
     if (n == 0) return;
-    grain = std::max<std::size_t>(grain, 1);
-    const auto chunks = static_cast<long long>((n + grain - 1) / grain);
+    const auto chunks = static_cast<long long>(chunk_count(n, grain));
     const int nthreads = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (long long c = 0; c < chunks; ++c) {
-      const std::size_t begin = static_cast<std::size_t>(c) * grain;
-      fn(begin, std::min(n, begin + grain));
+      const chunk_bounds r = chunk_at(n, grain, static_cast<std::size_t>(c));
+      fn(r.begin, r.end);
     }
   }
 };
 #endif
-
-// Number of fixed chunks of `grain` elements covering n elements (grain 0 counts as 1). O(1).
-constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
-  grain = grain == 0 ? 1 : grain;
-  return (n + grain - 1) / grain;
-}
 
 // Calls fn(chunk, begin, end) for each fixed chunk [chunk·grain, min(n, (chunk+1)·grain)),
 // in parallel through the executor. Chunk boundaries depend only on n and grain, so a per-chunk
@@ -82,10 +97,11 @@ constexpr std::size_t chunk_count(std::size_t n, std::size_t grain) noexcept {
 template <class E, class F>
   requires executor<std::remove_cvref_t<E>>
 void for_each_chunk(E&& exec, std::size_t n, std::size_t grain, F&& fn) {
-  grain = grain == 0 ? 1 : grain;
-  const std::size_t chunks = chunk_count(n, grain);
-  exec.parallel_for(chunks, 1, [&](std::size_t cb, std::size_t ce) {
-    for (std::size_t c = cb; c < ce; ++c) fn(c, c * grain, std::min(n, (c + 1) * grain));
+  exec.parallel_for(chunk_count(n, grain), 1, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c) {
+      const chunk_bounds r = chunk_at(n, grain, c);
+      fn(c, r.begin, r.end);
+    }
   });
 }
 

@@ -34,6 +34,15 @@ struct hit {
   glm::vec2 barycentric{0.0f};
   float distance = std::numeric_limits<float>::infinity();
   [[nodiscard]] constexpr bool valid() const noexcept { return triangle != invalid_id; }
+  // The barycentrics lie in the triangle up to barycentric_slack (u, v >= -slack, u + v <=
+  // 1 + slack; NaN fails): what any tracer's rounding gives. A hit failing this is a tracer bug;
+  // entry points that read hits treat it as a named error or, where they return no status, as a
+  // miss.
+  static constexpr float barycentric_slack = 1e-3f;
+  [[nodiscard]] constexpr bool barycentric_inside() const noexcept {
+    return barycentric.x >= -barycentric_slack && barycentric.y >= -barycentric_slack &&
+           barycentric.x + barycentric.y <= 1.0f + barycentric_slack;
+  }
 };
 
 template <class T>

@@ -302,8 +302,9 @@ class collapse_mesh {
 // Builds the hierarchy. weights: 3 per triangle (corner order; weighting_map.hpp), finite and
 // >= 0. cluster: one id < cluster_count per triangle. Errors: mesh errors (empty, index out of
 // range, non-finite position), a non-manifold edge (names the edge's first vertex), weights or
-// cluster of the wrong size (bad_size), a negative or non-finite weight (names the corner),
-// a cluster id out of range (names the triangle), options outside their ranges.
+// cluster of the wrong size (bad_size), a non-finite weight (non_finite) or a negative one
+// (bad_parameter), naming the corner, a cluster id out of range (names the triangle), options
+// outside their ranges.
 // Serial (the global order is inherently sequential); pure.
 template <class M>
 result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<const double> weights,
@@ -320,7 +321,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
   for (std::size_t k = 0; k < weights.size(); ++k)
     if (!(weights[k] >= 0.0) || !std::isfinite(weights[k]))
-      return make_error(errc::non_finite, k, "weight of corner ", k % 3, " of triangle ", k / 3, " is ", weights[k],
+      return make_error(std::isfinite(weights[k]) ? errc::bad_parameter : errc::non_finite, k, "weight of corner ", k % 3, " of triangle ", k / 3, " is ", weights[k],
                         "; must be finite and >= 0");
   for (std::size_t t = 0; t < nt; ++t)
     if (cluster[t] >= cluster_count)

@@ -64,8 +64,8 @@ inline contraction_workspace make_contraction_workspace(const contraction_hierar
   for (std::uint32_t c = 0; c < h.cluster_count; ++c)
     for (std::size_t t = h.triangle_offsets[c], e = t; t < h.triangle_offsets[c + 1]; t = e) {
       while (e < h.triangle_offsets[c + 1] && run_of(e) == run_of(t)) ++e;
-      for (std::size_t b = t; b < e; b += w.grain) {
-        w.chunk_begin.push_back(static_cast<std::uint32_t>(b));
+      for (std::size_t k = 0, chunks = chunk_count(e - t, w.grain); k < chunks; ++k) {
+        w.chunk_begin.push_back(static_cast<std::uint32_t>(t + chunk_at(e - t, w.grain, k).begin));
         w.chunk_run.push_back(static_cast<std::uint32_t>(w.run_owner.size()));
         w.chunk_cluster.push_back(c);
       }

@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -76,7 +77,10 @@ std::vector<double> smooth_vertex_values(const M& m, std::span<const double> val
 // The weighting map: 3 weights per triangle (corner order), every one finite and > 0 when some
 // saliency is > 0. Errors: the inputs of cluster_localized_saliency (sizes, negative or
 // non-finite saliency naming the vertex, cluster ids); options outside their ranges
-// (bad_parameter); a mesh with a zero bounding-box diagonal (degenerate_triangle).
+// (bad_parameter), or a smoothing σ whose square under- or overflows (bad_parameter); a mesh with
+// a zero bounding-box diagonal (degenerate_triangle); a weight that
+// overflows double for finite inputs, e.g. saliency near 1e300 or saliency × amplification
+// above 1.8e308 (bad_parameter, names the corner).
 // Complexity O(pairs within 2σ_s + T log T); allocation O(V + T). Parallel through exec;
 // identical bits for any executor.
 template <class M, class E = serial_executor>
@@ -99,13 +103,18 @@ result<std::vector<double>> weighting_map(const M& m, std::span<const double> sa
     const double diag = mesh_bounds(m).diagonal();
     const double sigma = opt.smoothing_scale * opt.epsilon * diag;
     if (!(sigma * sigma >= std::numeric_limits<double>::min()) || !std::isfinite(16.0 * sigma * sigma))
-      return make_error(errc::degenerate_triangle, no_element, "smoothing sigma ", sigma,
-                        " (scale x epsilon x bounding-box diagonal) is outside double precision");
+      return make_error(diag > 0.0 ? errc::bad_parameter : errc::degenerate_triangle, no_element, "smoothing sigma ",
+                        sigma, " (smoothing_scale x epsilon x bounding-box diagonal) is outside double precision");
     smoothed = smooth_vertex_values(m, saliency, sigma, exec, opt.grain);
   }
   auto local = cluster_localized_saliency(m, std::span<const double>(smoothed), cluster, cluster_count);
   if (!local.ok()) return local.error();
   amplify_weights(*local, opt.amplify_percentile, opt.amplification);
+  for (std::size_t k = 0; k < local->size(); ++k)  // finite inputs can still overflow double
+    if (!std::isfinite((*local)[k]))
+      return make_error(errc::bad_parameter, k, "weighting map: the weight of corner ", k % 3, " of triangle ", k / 3,
+                        " overflows double (saliency up to ", *std::max_element(saliency.begin(), saliency.end()),
+                        ", amplification ", opt.amplification, "); scale the saliency down");
   return std::move(*local);
 }
 

@@ -29,7 +29,8 @@ inline std::vector<std::uint32_t> morton_order(std::span<const glm::dvec3> point
   for (std::size_t i = 0; i < points.size(); ++i) {
     std::uint64_t code = 0;
     for (int a = 0; a < 3; ++a) {
-      const auto q = static_cast<std::uint64_t>(std::clamp((points[i][a] - box.lo[a]) / ext[a], 0.0, 1.0) * 2097151.0);
+      const double x = (points[i][a] - box.lo[a]) / ext[a];  // NaN (an infinite extent) counts as 0
+      const auto q = static_cast<std::uint64_t>((x > 0.0 ? std::min(x, 1.0) : 0.0) * 2097151.0);
       for (int bit = 0; bit < 21; ++bit) code |= (q >> bit & 1u) << (3 * bit + a);
     }
     key[i] = {code, static_cast<std::uint32_t>(i)};

@@ -67,9 +67,18 @@ struct pinhole_camera {
   std::uint32_t width = 320;           // image width in pixels
   std::uint32_t height = 240;          // image height in pixels
 
+  // The unit view direction, scaled before normalising so that any finite eye and target whose
+  // difference is a finite float give one (their squared distance may overflow); (0,0,0) when
+  // they coincide or the difference overflows.
+  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) {
+    const glm::vec3 d = target - eye;
+    const float scale = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    return scale > 0.0f && std::isfinite(scale) ? glm::normalize(d / scale) : glm::vec3(0.0f);
+  }
+
   [[nodiscard]] ray primary_ray(std::uint32_t x, std::uint32_t y) const {
-    const glm::vec3 f = glm::normalize(target - eye);
-    const glm::vec3 r = glm::normalize(glm::cross(f, up));
+    const glm::vec3 f = forward(eye, target);
+    const glm::vec3 r = glm::normalize(glm::cross(f, forward(glm::vec3(0.0f), up)));
     const glm::vec3 u = glm::cross(r, f);
     const float h = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
     const float aspect = float(width) / float(height);
@@ -426,8 +435,10 @@ class progressive_refiner {
         if (!std::isfinite(e[k]) || !std::isfinite(t[k]) || !std::isfinite(u[k]))
           return make_error(errc::non_finite, no_element, "camera eye, target or up is not finite");
       if (e == t) return make_error(errc::bad_parameter, no_element, "camera eye equals target: no view direction");
-      const glm::vec3 f = glm::normalize(t - e);
-      if (!(glm::length(glm::cross(f, u)) > 1e-6f * glm::length(u)))
+      const glm::vec3 f = pinhole_camera::forward(e, t);
+      if (f == glm::vec3(0.0f))
+        return make_error(errc::bad_parameter, no_element, "camera eye and target are too far apart: target - eye overflows float");
+      if (!(glm::length(glm::cross(f, pinhole_camera::forward(glm::vec3(0.0f), u))) > 1e-6f))
         return make_error(errc::bad_parameter, no_element, "camera up is zero or parallel to the view direction");
       const float fov = camera.vertical_fov_degrees;
       if (!(fov > 0.0f && fov < 180.0f))
@@ -471,6 +482,9 @@ class progressive_refiner {
       if (!std::isfinite(h.distance) || !std::isfinite(h.barycentric.x) || !std::isfinite(h.barycentric.y))
         return make_error(errc::non_finite, p, "pixel ", p, ": hit on triangle ", h.triangle,
                           " has a non-finite distance or barycentric");
+      if (!h.barycentric_inside())
+        return make_error(errc::bad_parameter, p, "pixel ", p, ": hit on triangle ", h.triangle, " has barycentric (",
+                          h.barycentric.x, ", ", h.barycentric.y, ") outside the triangle");
     }
     return {};
   }

@@ -224,8 +224,9 @@ class subdivision_mesh {
  public:
   // Builds the hierarchy roots (triangle t of the input is hierarchy triangle t, vertex v is
   // vertex v). Errors: no triangles; non-finite position; index out of range; degenerate
-  // triangle (repeated index or zero area); an edge shared by more than two triangles;
-  // bisect_ratio negative or NaN. Complexity O(V + T) expected; allocation O(V + T).
+  // triangle (repeated index or zero area); an edge shared by more than two triangles, or two
+  // triangles on the same three vertices; bisect_ratio negative or NaN. Complexity O(V + T)
+  // expected; allocation O(V + T).
   template <class M>
   static result<subdivision_mesh> create(const M& m, subdivision_options options = {}) {
     static_assert(check_mesh<M>());
@@ -254,6 +255,18 @@ class subdivision_mesh {
         [[maybe_unused]] const bool manifold = detail::edge_table::add_face(e, id);
         INFOLERP_ASSERT(manifold && "validate_mesh rejects non-manifold edges");
       }
+    }
+    // Two triangles on the same three vertices (either winding) would share all three midpoints,
+    // and their children the inner edges: a split could not keep two faces per edge.
+    for (std::uint32_t t = 0; t < nt; ++t) {
+      const glm::uvec3 v = s.tris_[t].vertices;
+      const auto other = [&](std::uint32_t a, std::uint32_t b) {
+        const auto& e = s.edges_.get(a, b);
+        return e.face[0] == t ? e.face[1] : e.face[0];
+      };
+      if (const std::uint32_t o = other(v[0], v[1]); o != invalid_id && o == other(v[1], v[2]) && o == other(v[2], v[0]))
+        return make_error(errc::non_manifold_edge, t, "triangles ", std::min(t, o), " and ", std::max(t, o),
+                          " have the same three vertices");
     }
     s.original_count_ = nt;
     s.original_vertex_count_ = nv;

@@ -140,7 +140,8 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
       mx = std::max(mx, s[grid.id[k]]);
     }
     const double range = std::max(mx, opt.flat_level_threshold * mean_abs_c);
-    if (!(range > 0.0)) continue;  // a flat mesh: this level adds nothing
+    // A flat mesh, or a range so small that 1/range overflows: this level adds nothing.
+    if (!(range >= std::numeric_limits<double>::min())) continue;
     const double scale = 1.0 / range, big_m = mx * scale;
     std::size_t global = nv;
     for (std::size_t v = 0; v < nv; ++v) {

@@ -54,7 +54,7 @@ struct hard_shadow_light {
 };
 
 struct ray_cast_options {
-  unsigned ao_rays = 64;                 // AO directions per evaluation (0: ao = 1)
+  unsigned ao_rays = 64;                 // AO directions per evaluation (0: ao = 1; at most 65,536: 768 KiB of directions)
   float ao_radius = 1.5f;                // AO rays look this far
   float ray_offset = 1e-3f;              // secondary rays start this far off the surface
   std::vector<hard_shadow_light> lights{};  // up to 32; light i sets bit i
@@ -117,7 +117,12 @@ class ray_cast_source {
 
   // clusters[g][t]: the cluster id of triangle t of geometry g; the arrays must cover every
   // triangle a primary ray can hit (unchecked). The tracer must outlive the source.
-  // Errors: more than 32 lights, a non-finite or negative ao_radius or ray_offset (bad_parameter).
+  // Errors: more than 32 lights, ao_rays above 65,536, a non-finite or negative ao_radius or
+  // ray_offset, a non-finite view_origin or view_forward (bad_parameter); a NaN or infinite
+  // vertex normal or texcoord of geometry g < clusters.size() (non_finite, names the vertex or
+  // triangle); texcoords of the library's adaptors present but not 3 per triangle (bad_size).
+  // Zero normals are accepted: where the interpolated normal has no direction the geometric
+  // normal shades (see surface()). O(V + T) of the geometries for the checks, no allocation.
   [[nodiscard]] static result<ray_cast_source> create(const Tracer& tracer, Camera camera, Geometry geometry,
                                                       Material material,
                                                       std::vector<std::span<const std::uint32_t>> clusters,
@@ -126,10 +131,16 @@ class ray_cast_source {
     if (options.lights.size() > 32)
       return make_error(errc::bad_parameter, options.lights.size(), "ray_cast_source: ", options.lights.size(),
                         " hard-shadow lights; at most 32 fit the light bits");
+    if (options.ao_rays > 65536)
+      return make_error(errc::bad_parameter, no_element, "ray_cast_source: ao_rays ", options.ao_rays, " above 65536");
     if (!(options.ao_radius >= 0.0f) || !std::isfinite(options.ao_radius))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ao_radius must be finite and >= 0");
     if (!(options.ray_offset >= 0.0f) || !std::isfinite(options.ray_offset))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ray_offset must be finite and >= 0");
+    if (!finite3(options.view_origin) || !finite3(options.view_forward))
+      return make_error(errc::bad_parameter, no_element, "ray_cast_source: view_origin and view_forward must be finite");
+    for (std::uint32_t g = 0; g < clusters.size(); ++g)
+      if (status s = check_attributes(geometry(g), g); !s.ok()) return s;
     return ray_cast_source(tracer, std::move(camera), std::move(geometry), std::move(material), std::move(clusters),
                            std::move(options));
   }
@@ -171,13 +182,36 @@ class ray_cast_source {
         clusters_(std::move(clusters)), options_(std::move(options)), hemisphere_(cosine_hemisphere(options_.ao_rays)) {}
 
   static float pixel(std::uint32_t i) { return static_cast<float>(i) + 0.5f; }
+  static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+  // Normals and texcoords that surface() reads: finite, and texcoords of the adaptors whole.
+  template <class M>
+  static status check_attributes(const M& m, std::uint32_t g) {
+    if constexpr (requires { m.texcoords.size(); })
+      if (!m.texcoords.empty() && !mesh_has_texcoords(m))
+        return make_error(errc::bad_size, g, "ray_cast_source: geometry ", g, " has ", m.texcoords.size(),
+                          " texcoords for ", mesh_triangle_count(m), " triangles (3 per triangle needed)");
+    if constexpr (mesh_with_normals<M>)
+      if (mesh_has_normals(m))
+        for (std::size_t v = 0; v < mesh_vertex_count(m); ++v)
+          if (!finite3(mesh_traits<M>::normal(m, v)))
+            return make_error(errc::non_finite, v, "ray_cast_source: geometry ", g, " vertex ", v, " has a non-finite normal");
+    if constexpr (textured_mesh<M>)
+      if (mesh_has_texcoords(m))
+        for (std::size_t t = 0; t < mesh_triangle_count(m); ++t)
+          for (unsigned c = 0; c < 3; ++c)
+            if (const glm::vec2 w = mesh_traits<M>::texcoord(m, t, c); !std::isfinite(w.x) || !std::isfinite(w.y))
+              return make_error(errc::non_finite, t, "ray_cast_source: geometry ", g, " triangle ", t, " corner ", c,
+                                " has a non-finite texcoord");
+    return {};
+  }
 
   // Primary hit, then the terms asked for: hard-shadow bits, then soft shadow and AO.
   sample_type trace(std::uint32_t x, std::uint32_t y, bool hard, bool occlusion) const {
     const ray primary = camera_(pixel(x), pixel(y));
     const hit h = tracer_->intersect(primary);
     sample_type s;
-    if (!h.valid()) return s;
+    if (!h.valid() || !h.barycentric_inside()) return s;  // a hit outside its triangle: a miss
     glm::vec3 ng;
     surface(primary, h, s, ng);
     const glm::vec3 origin = s.position + options_.ray_offset * ng;
@@ -187,7 +221,10 @@ class ray_cast_source {
   }
 
   // The hit's position, shading normal (facing the camera), texcoords, cluster id and inv_depth;
-  // ng: the geometric normal on the camera's side (secondary rays leave on that side).
+  // ng: the geometric normal on the camera's side (secondary rays leave on that side). Rules for
+  // directions that have none: a triangle whose cross product does not normalise (zero area,
+  // overflow) takes the reversed primary direction as ng; an interpolated vertex normal that does
+  // not normalise (zero, cancelling, overflowing) leaves ng as the shading normal.
   void surface(const ray& primary, const hit& h, sample_type& s, glm::vec3& ng) const {
     const auto& m = geometry_(h.geometry);
     using M = std::remove_cvref_t<decltype(m)>;
@@ -196,13 +233,13 @@ class ray_cast_source {
     const glm::vec3 p0 = mesh_position(m, tri.x), p1 = mesh_position(m, tri.y), p2 = mesh_position(m, tri.z);
     s.position = w * p0 + u * p1 + v * p2;
     s.cluster = clusters_[h.geometry][h.triangle];
-    ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    ng = unit_or(glm::cross(p1 - p0, p2 - p0), -glm::normalize(primary.direction));
     if (glm::dot(ng, primary.direction) > 0.0f) ng = -ng;
     s.normal = ng;
     if constexpr (mesh_with_normals<M>) {
       if (mesh_has_normals(m)) {
-        glm::vec3 n = glm::normalize(w * mesh_traits<M>::normal(m, tri.x) + u * mesh_traits<M>::normal(m, tri.y) +
-                                     v * mesh_traits<M>::normal(m, tri.z));
+        glm::vec3 n = unit_or(w * mesh_traits<M>::normal(m, tri.x) + u * mesh_traits<M>::normal(m, tri.y) +
+                                  v * mesh_traits<M>::normal(m, tri.z), ng);
         s.normal = glm::dot(n, ng) < 0.0f ? -n : n;
       }
     }
@@ -211,8 +248,19 @@ class ray_cast_source {
         s.texcoord = w * mesh_traits<M>::texcoord(m, h.triangle, 0) + u * mesh_traits<M>::texcoord(m, h.triangle, 1) +
                      v * mesh_traits<M>::texcoord(m, h.triangle, 2);
     }
-    if (options_.view_forward != glm::vec3(0.0f))
-      s.inv_depth = 1.0f / std::max(glm::dot(s.position - options_.view_origin, options_.view_forward), 1e-6f);
+    // Depth clamped to [1e-6, 1/FLT_MIN], NaN (an overflowing difference) counting as far: inv_depth
+    // stays a normal positive float, so the upsampler's sums of inv_depth invert to finite weights.
+    if (options_.view_forward != glm::vec3(0.0f)) {
+      constexpr float far = 1.0f / std::numeric_limits<float>::min();
+      const float depth = glm::dot(s.position - options_.view_origin, options_.view_forward);
+      s.inv_depth = 1.0f / std::clamp(std::isnan(depth) ? far : depth, 1e-6f, far);
+    }
+  }
+
+  // d normalised, or fallback when d has no direction a float can hold.
+  static glm::vec3 unit_or(const glm::vec3& d, const glm::vec3& fallback) {
+    const float len2 = glm::dot(d, d);
+    return len2 > 0.0f && std::isfinite(len2) ? glm::normalize(d) : fallback;
   }
 
   // §4.1: bit i set when light i is in front of the surface and unoccluded.

@@ -135,8 +135,9 @@ class upsampler {
   using sample_type = Sample;
 
   // An upsampler for a width×height image, or why not: width or height 0 (errc::empty_input),
-  // max_passes outside [1, 16], passes outside [1, max_passes], rows_per_task 0, or a side
-  // above 2^24 (errc::bad_parameter).
+  // max_passes outside [1, 16], passes outside [1, max_passes], rows_per_task 0, a side above
+  // 2^24, or a pyramid above 1 GiB: W·H·sizeof(Sample)/3 bytes (4/3 with keep_ibuffer), e.g.
+  // 7680×4320 of 64-byte samples fits, twice that does not (errc::bad_parameter).
   // Allocation: the coarser passes, about (1/3)·W·H samples (precisely Σ_{d≥1} w_d·h_d ≤
   // 1/3·W·H + 4(W+H) + 4·max_passes samples with w_0 = W, w_d = floor(w_{d−1}/2)+1), plus W·H
   // more with keep_ibuffer, W·H bytes with record_kinds, and H row counters.
@@ -166,6 +167,10 @@ class upsampler {
     if (width > limit || height > limit)
       return make_error(errc::bad_parameter, no_element, "upsampler: image size ", width, "x", height,
                         " above 2^24 per side");
+    if (const std::uint64_t bytes = std::uint64_t{width} * height * sizeof(Sample) * (options_.keep_ibuffer ? 4 : 1) / 3;
+        bytes > (std::uint64_t{1} << 30))
+      return make_error(errc::bad_parameter, no_element, "upsampler: image size ", width, "x", height, " needs ", bytes,
+                        " bytes of samples, above the 1 GiB bound");
     width_ = width;
     height_ = height;
     std::uint32_t w = width, h = height;
