@@ -1,7 +1,10 @@
 // infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A] [--percentile P]
-//                     [--only-given] [--no-frames]
+//                     [--only-given] [--no-frames] [--no-simplify] [--no-views] [--fraction F]
+//                     [--clusters N] [--hidden W] [--silhouette W] [--near F]
 // (--amplification, --percentile: the weighting map's λ and α, defaults 1 and 30; --only-given:
-// only the --mesh meshes; --no-frames: no frame rows)
+// only the --mesh meshes; --no-frames, --no-simplify, --no-views: leave out those rows;
+// --fraction: view rows of that fraction only; --clusters: salient clusters, default 10 as the
+// paper; --hidden, --silhouette, --near: view_weight_options of the default selection)
 //
 // View-dependent multiresolution rendering (salient-clustering paper §III.C, §IV) against
 // meshoptimizer's meshopt_simplify, the simplifier an engine would otherwise call.
@@ -23,7 +26,7 @@
 //   triangles), so that the 1% row exists, and in one global order (cluster_local_first off, as
 //   §III.C simplifies "over the entire mesh"; a uniform prefix of the cluster-local order keeps
 //   full-resolution bands along cluster borders); 10 salient clusters, default weighting map.
-//   The frame rows use the default hierarchy (cluster-local phase first).
+//   The frame rows use the default hierarchy (one global order).
 //   kind=frame, mesh refined_elephant_x4 (refined_elephant subdivided once 1:4 at edge
 //   midpoints, 355,712 triangles), fraction 0.05, 0.35, 0.60 of the triangles: method update
 //   (view_dependent_lod::frame: importance, eq. 9, matching, contraction into the index buffer;
@@ -32,7 +35,20 @@
 //   the triangle count update produced, from scratch); minimum over --reps repetitions
 //   interleaved in one loop, each timed update and memcpy right after an untimed one (warm). Distances are left empty for frame rows. stdout also gives the
 //   update with openmp_executor{2} (checked to produce the same index buffer) and medians.
-// stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios.
+//   kind=view (a second header line gives its columns: kind,mesh,method,fraction,view,triangles,
+//   psnr_db,ssim,weighted_distance,salient_distance,seconds), per mesh, fraction and camera:
+//   cameras orbit0..7 (those of support/mesh_views.hpp, whole mesh in frame) and close0..7
+//   (between them, at 1.2 bounding radii from the box centre: the mesh overflows the frustum);
+//   methods infolerp (view_dependent_lod::frame with default options on the default hierarchy
+//   with backstop 0.005), infolerp_paper (lod_selection::paper on a cluster-local-first
+//   hierarchy) and meshoptimizer (meshopt_simplify of the whole mesh to the triangle count
+//   infolerp drew for that camera); the budget is the global prefix's contraction count for the
+//   fraction. psnr_db, ssim: that camera's 256x256 reference-shader image against the full
+//   mesh's; weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
+//   over the 10% most salient vertices (d: distance to the simplified surface); seconds: one
+//   frame() or meshopt_simplify call.
+// stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios, and
+// the mean PSNR per mesh, fraction and camera set.
 #include <meshoptimizer.h>
 #include <algorithm>
 #include <array>

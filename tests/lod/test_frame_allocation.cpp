@@ -13,7 +13,7 @@ TEST_CASE("a frame allocates nothing after setup", "[lod]") {
   std::vector<std::uint32_t> cl(m.triangle_count());
   for (std::size_t t = 0; t < cl.size(); ++t) cl[t] = static_cast<std::uint32_t>(t % 5);
   std::vector<double> sal(m.vertex_count(), 1.0), w(3 * m.triangle_count(), 1.0);
-  auto h = make_contraction_hierarchy(m, w, cl, 5);
+  auto h = make_contraction_hierarchy(m, w, cl, 5, {.cluster_local_first = true});
   REQUIRE(h.ok());
   auto table = compute_cluster_attributes(m, sal, cl, 5);
   REQUIRE(table.ok());

@@ -358,7 +358,7 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 1.0 + 0.5 * std::sin(3.0 * m.positions[v].x);
   auto wm = weighting_map(m, sal, cl, 8);
   REQUIRE(wm.ok());
-  auto h = make_contraction_hierarchy(m, *wm, cl, 8);
+  auto h = make_contraction_hierarchy(m, *wm, cl, 8, {.cluster_local_first = true});
   REQUIRE(h.ok());
   auto table = compute_cluster_attributes(m, sal, cl, 8);
   REQUIRE(table.ok());

@@ -13,9 +13,12 @@
 // Floor: a weight below weight_floor × the mean weight counts as that (all weights 1 when the
 // mean is 0), so that a region of zero saliency (a floor, a wall) keeps its feature and boundary
 // planes instead of collapsing at no cost.
-// Cluster-local phase (cluster_local_first): contractions whose vertices and 1-rings lie in one
-// cluster run first, so clusters simplify independently and neighbour matching does not drag
-// every cluster to the coarsest; then the whole mesh, down to backstop × V vertices (paper: 1%).
+// Cluster-local phase (cluster_local_first, for the paper's eq. 9 selection): contractions whose
+// vertices and 1-rings lie in one cluster run first, so clusters simplify independently and
+// neighbour matching does not drag every cluster to the coarsest; then the whole mesh, down to
+// backstop × V vertices (paper: 1%). Off by default: run to exhaustion, the phase leaves
+// full-resolution bands along cluster borders, and view_dependent_lod's default selection
+// does better on one global order (benchmarks/NOTES.md).
 //
 // Hierarchy, per contraction i: removed[i], target[i], parent[i] (the last contraction that
 // changed the fan of u, v or a neighbour; no_parent if none), its owning cluster (that of the
@@ -50,7 +53,7 @@ struct simplification_options {
   double backstop = 0.01;         // stop when this fraction of the vertices is left, in [0, 1]
   double boundary_weight = 10.0;  // weight of the planes that hold mesh-boundary edges, >= 0
   double min_normal_cos = 0.0;    // a triangle's normal may turn by at most acos of this, in [0, 1)
-  bool cluster_local_first = true;  // first only contractions whose 2-ring lies in one cluster (see above)
+  bool cluster_local_first = false;  // first only contractions whose 2-ring lies in one cluster (see above)
   double weight_floor = 0.1;      // weights below this fraction of their mean count as it, in [0, 1] (see above)
 };
 
