@@ -238,7 +238,7 @@ void frame_rows(std::FILE* csv, int reps) {
       if (!st.ok()) return void(std::fprintf(stderr, "%s\n", st.error().message().c_str()));
       tris = st->indices / 3;
       if (r == 0)
-        std::printf("# fraction %.2f: budget %llu contractions, eq. 9 gave %llu, applied after matching %llu (%u sweeps, %zu cross-cluster dependencies)\n",
+        std::printf("# fraction %.2f: budget %llu contractions, %llu before matching, applied %llu (%u selection rounds, %zu cross-cluster dependencies)\n",
                     f, static_cast<unsigned long long>(budget), static_cast<unsigned long long>(st->budgeted),
                     static_cast<unsigned long long>(st->applied), st->matching_sweeps, h->cross.size());
       std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
