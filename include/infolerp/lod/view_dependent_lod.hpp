@@ -4,14 +4,15 @@
 //
 // Selection (lod_options::selection):
 //   screen_error (default): per-cluster budgets from one projected-error threshold, the view
-//     weight seeing the frustum, back-facing clusters and silhouettes, matched so that the
-//     budget holds after matching (screen_error_selection.hpp);
+//     weight seeing the frustum, back-facing clusters and silhouettes, chosen so that the
+//     budget holds after neighbour matching (screen_error_selection.hpp); meant for the default
+//     hierarchy (one global order);
 //   paper: eqs. 5–9 as written: A_est, I_est per cluster (cluster_importance.hpp) and eq. 9's
 //     equal portions by A_est·I_est, each cluster clamped to its cluster-local capacity
-//     (contraction_hierarchy.hpp explains the cluster-local phase); a budget beyond the local
-//     phase is a global prefix (every local contraction plus the first R_global − Σ local of the
-//     rest, the same for all clusters; a prefix of the global order needs no matching).
-//     then stop points and neighbour matching (view_selection.hpp).
+//     (contraction_hierarchy.hpp explains the cluster-local phase, which this option needs); a
+//     budget beyond the local phase is a global prefix (every local contraction plus the first
+//     R_global − Σ local of the rest, the same for all clusters; a prefix of the global order
+//     needs no matching); then neighbour matching (view_selection.hpp).
 // Both then contract into the caller's index buffer (vertex_contraction.hpp).
 // Each step is usable on its own; this class keeps their buffers between frames, so frame()
 // allocates nothing after construction (unless it returns an error). Any valid camera gets a
@@ -83,7 +84,8 @@ class view_dependent_lod {
   // One frame. Errors: an invalid camera (check_camera: bad_parameter, or bad_size for an empty
   // viewport), global_contractions > capacity() (bad_parameter); out smaller than
   // contracted_index_bound or ranges not one per cluster (bad_size).
-  // O(C log C + 64 C log n + contractions + kept triangles / threads).
+  // screen_error: O(11 · (64 · C log n + matching) + contractions + kept triangles / threads);
+  // paper: O(C log C + matching + contractions + kept triangles / threads).
   template <class E = serial_executor>
   result<lod_frame_stats> frame(const lod_camera& camera, std::uint64_t global_contractions,
                                 std::span<std::uint32_t> out, std::span<index_range> ranges, E&& exec = E{}) {
