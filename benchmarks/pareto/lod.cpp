@@ -1,7 +1,10 @@
 // infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A] [--percentile P]
-//                     [--only-given] [--no-frames]
+//                     [--only-given] [--no-frames] [--no-simplify] [--no-views] [--fraction F]
+//                     [--clusters N] [--hidden W] [--silhouette W] [--near F]
 // (--amplification, --percentile: the weighting map's λ and α, defaults 1 and 30; --only-given:
-// only the --mesh meshes; --no-frames: no frame rows)
+// only the --mesh meshes; --no-frames, --no-simplify, --no-views: leave out those rows;
+// --fraction: view rows of that fraction only; --clusters: salient clusters, default 10 as the
+// paper; --hidden, --silhouette, --near: view_weight_options of the default selection)
 //
 // View-dependent multiresolution rendering (salient-clustering paper §III.C, §IV) against
 // meshoptimizer's meshopt_simplify, the simplifier an engine would otherwise call.
@@ -23,7 +26,7 @@
 //   triangles), so that the 1% row exists, and in one global order (cluster_local_first off, as
 //   §III.C simplifies "over the entire mesh"; a uniform prefix of the cluster-local order keeps
 //   full-resolution bands along cluster borders); 10 salient clusters, default weighting map.
-//   The frame rows use the default hierarchy (cluster-local phase first).
+//   The frame rows use the default hierarchy (one global order).
 //   kind=frame, mesh refined_elephant_x4 (refined_elephant subdivided once 1:4 at edge
 //   midpoints, 355,712 triangles), fraction 0.05, 0.35, 0.60 of the triangles: method update
 //   (view_dependent_lod::frame: importance, eq. 9, matching, contraction into the index buffer;
@@ -32,7 +35,20 @@
 //   the triangle count update produced, from scratch); minimum over --reps repetitions
 //   interleaved in one loop, each timed update and memcpy right after an untimed one (warm). Distances are left empty for frame rows. stdout also gives the
 //   update with openmp_executor{2} (checked to produce the same index buffer) and medians.
-// stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios.
+//   kind=view (a second header line gives its columns: kind,mesh,method,fraction,view,triangles,
+//   psnr_db,ssim,weighted_distance,salient_distance,seconds), per mesh, fraction and camera:
+//   cameras orbit0..7 (those of support/mesh_views.hpp, whole mesh in frame) and close0..7
+//   (between them, at 1.2 bounding radii from the box centre: the mesh overflows the frustum);
+//   methods infolerp (view_dependent_lod::frame with default options on the default hierarchy
+//   with backstop 0.005), infolerp_paper (lod_selection::paper on a cluster-local-first
+//   hierarchy) and meshoptimizer (meshopt_simplify of the whole mesh to the triangle count
+//   infolerp drew for that camera); the budget is the global prefix's contraction count for the
+//   fraction. psnr_db, ssim: that camera's 256x256 reference-shader image against the full
+//   mesh's; weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
+//   over the 10% most salient vertices (d: distance to the simplified surface); seconds: one
+//   frame() or meshopt_simplify call.
+// stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios, and
+// the mean PSNR per mesh, fraction and camera set.
 #include <meshoptimizer.h>
 #include <algorithm>
 #include <array>
@@ -75,12 +91,13 @@ struct prepared {
 };
 
 weighting_map_options g_weighting;  // --amplification, --percentile
+std::uint32_t g_clusters = 10;      // --clusters: salient clusters (the paper: 10)
 
 bool prepare(const indexed_mesh& m, prepared& p) {
   auto sal = compute_saliency(m);
   if (!sal.ok()) return std::fprintf(stderr, "saliency: %s\n", sal.error().message().c_str()), false;
   p.saliency = sal->saliency;
-  auto cl = salient_clustering(m, p.saliency, {.clusters = 10});
+  auto cl = salient_clustering(m, p.saliency, {.clusters = g_clusters});
   if (!cl.ok()) return std::fprintf(stderr, "clustering: %s\n", cl.error().message().c_str()), false;
   p.clusters = std::move(*cl);
   auto w = weighting_map(m, p.saliency, p.clusters.cluster, p.clusters.count, g_weighting);
@@ -198,7 +215,8 @@ void frame_rows(std::FILE* csv, int reps) {
   std::printf("# refined_elephant_x4: %zu triangles, %zu vertices, hierarchy built in %.3f s, %.2f bytes/triangle\n", nt,
               m.vertex_count(), build, static_cast<double>(h->memory_bytes()) / static_cast<double>(nt));
   const bounding_box box = mesh_bounds(m);
-  const glm::dvec3 camera = box.center() + glm::dvec3(0.0, 0.0, 2.0 * box.diagonal());
+  const glm::dvec3 eye = box.center() + glm::dvec3(0.0, 0.0, 2.0 * box.diagonal());
+  const lod_camera camera{eye, box.center() - eye, {0.0, 1.0, 0.0}, 0.7, 1024, 1024};
   const auto* idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
   std::vector<std::uint32_t> out(contracted_index_bound(*h)), out2(out.size()), copy(3 * nt), mo(3 * nt);
   std::vector<index_range> ranges(h->cluster_count);
@@ -220,7 +238,7 @@ void frame_rows(std::FILE* csv, int reps) {
       if (!st.ok()) return void(std::fprintf(stderr, "%s\n", st.error().message().c_str()));
       tris = st->indices / 3;
       if (r == 0)
-        std::printf("# fraction %.2f: budget %llu contractions, eq. 9 gave %llu, applied after matching %llu (%u sweeps, %zu cross-cluster dependencies)\n",
+        std::printf("# fraction %.2f: budget %llu contractions, %llu before matching, applied %llu (%u selection rounds, %zu cross-cluster dependencies)\n",
                     f, static_cast<unsigned long long>(budget), static_cast<unsigned long long>(st->budgeted),
                     static_cast<unsigned long long>(st->applied), st->matching_sweeps, h->cross.size());
       std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
@@ -250,13 +268,131 @@ void frame_rows(std::FILE* csv, int reps) {
   }
 }
 
+// Original vertex → simplified surface distances: saliency-weighted mean over all vertices and
+// over the 10% most salient (one direction only; measure() adds the Hausdorff distance).
+struct view_distances {
+  double weighted = 0.0, salient = 0.0;
+};
+
+view_distances vertex_distances(const indexed_mesh& m, const std::vector<double>& saliency, double salient_cut,
+                                std::span<const std::uint32_t> simplified) {
+  support::surface_distance to_simplified(m.positions, simplified);
+  double num = 0.0, den = 0.0, snum = 0.0, sden = 0.0;
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    if (saliency[v] <= 0.0) continue;
+    const double d = to_simplified(glm::dvec3(m.positions[v]));
+    num += saliency[v] * d, den += saliency[v];
+    if (saliency[v] >= salient_cut) snum += saliency[v] * d, sden += saliency[v];
+  }
+  return {den > 0.0 ? num / den : 0.0, sden > 0.0 ? snum / sden : 0.0};
+}
+
+// The 8 orbit cameras of support/mesh_views.hpp and 8 close ones: the same directions turned by
+// half a step, the eye at 1.2 bounding radii from the box centre looking at it, so that the
+// mesh overflows the 40° frustum.
+std::vector<support::camera> view_cameras(const indexed_mesh& m) {
+  std::vector<support::camera> cams;
+  for (unsigned k = 0; k < 8; ++k) cams.push_back(support::mesh_view_camera(k, 8, m.positions));
+  for (unsigned k = 0; k < 8; ++k) {
+    support::camera c = support::mesh_view_camera(2 * k + 1, 16, m.positions);
+    const glm::vec3 dir = glm::normalize(c.eye - c.target);
+    const bounding_box box = mesh_bounds(m);
+    c.eye = c.target + static_cast<float>(1.2 * 0.5 * box.diagonal()) * dir;
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+lod_camera to_lod_camera(const support::camera& c, std::uint32_t size) {
+  return {glm::dvec3(c.eye), glm::dvec3(c.target - c.eye), glm::dvec3(c.up),
+          static_cast<double>(c.vertical_fov_degrees) * 3.141592653589793 / 180.0, size, size};
+}
+
+double g_view_fraction = 0.0;  // --fraction: only this one (0: all)
+lod_options g_lod;             // --hidden, --silhouette, --near: the view weights of the default selection
+
+// kind=view rows (see the top of the file).
+void view_rows(std::FILE* csv, const support::embree_device& device, const std::string& name, const indexed_mesh& m) {
+  prepared p;
+  if (!prepare(m, p)) return;
+  const std::size_t nt = m.triangle_count();
+  auto table = compute_cluster_attributes(m, p.saliency, p.clusters.cluster, p.clusters.count);
+  if (!table.ok()) return void(std::fprintf(stderr, "%s\n", table.error().message().c_str()));
+  auto t0 = clk::now();
+  auto h = make_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .cluster_local_first = false});
+  const double build = seconds_since(t0);
+  auto hp = make_contraction_hierarchy(m, p.weights, p.clusters.cluster, p.clusters.count, {.backstop = 0.005, .cluster_local_first = true});
+  if (!h.ok() || !hp.ok()) return void(std::fprintf(stderr, "%s: hierarchy failed\n", name.c_str()));
+  auto lod = view_dependent_lod::create(*h, *table, g_lod);
+  auto lodp = view_dependent_lod::create(*hp, *table, lod_options{.selection = lod_selection::paper, .view = {}});
+  if (!lod.ok() || !lodp.ok()) return void(std::fprintf(stderr, "%s: lod failed\n", name.c_str()));
+  std::vector<double> sorted = p.saliency;
+  std::sort(sorted.begin(), sorted.end());
+  const double salient_cut = sorted[static_cast<std::size_t>(0.9 * static_cast<double>(sorted.size()))];
+  const std::vector<support::camera> cams = view_cameras(m);
+  const support::mesh_view_options vopt;
+  const std::span<const std::uint32_t> original(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * nt);
+  std::vector<support::image> full;
+  for (const support::camera& c : cams) {
+    auto img = support::render_mesh_views(device, m.positions, original, std::span<const support::camera>(&c, 1), vopt);
+    if (!img) return void(std::fprintf(stderr, "views: %s\n", img.error().message().c_str()));
+    full.push_back(std::move((*img)[0]));
+  }
+  std::printf("# %s view rows: hierarchy %.3f s, %u clusters\n", name.c_str(), build, p.clusters.count);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), mo(3 * nt);
+  std::vector<index_range> ranges(h->cluster_count);
+  for (double f : {0.35, 0.10, 0.05, 0.01}) {
+    if (g_view_fraction > 0.0 && std::abs(f - g_view_fraction) > 1e-9) continue;
+    const auto target = static_cast<std::size_t>(std::lround(f * static_cast<double>(nt)));
+    double psnr_sum[3] = {0, 0, 0};
+    for (std::size_t v = 0; v < cams.size(); ++v) {
+      const lod_camera cam = to_lod_camera(cams[v], static_cast<std::uint32_t>(vopt.width));
+      const std::string view = (v < 8 ? "orbit" : "close") + std::to_string(v % 8);
+      std::size_t drawn = 0;
+      for (int method = 0; method < 3; ++method) {
+        std::span<const std::uint32_t> idx;
+        t0 = clk::now();
+        if (method < 2) {
+          view_dependent_lod& l = method == 0 ? *lod : *lodp;
+          const contraction_hierarchy& hh = method == 0 ? *h : *hp;
+          auto st = l.frame(cam, std::min<std::uint64_t>(l.capacity(), prefix_for(hh, target)), out, ranges);
+          if (!st.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), st.error().message().c_str()));
+          idx = std::span<const std::uint32_t>(out.data(), st->indices);
+          if (method == 0) drawn = st->indices / 3;
+        } else {
+          const auto* in = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
+          const std::size_t k = meshopt_simplify(mo.data(), in, 3 * nt, &m.positions[0].x, m.vertex_count(), sizeof(glm::vec3),
+                                                 3 * drawn, std::numeric_limits<float>::max(), 0, nullptr);
+          idx = std::span<const std::uint32_t>(mo.data(), k);
+        }
+        const double sec = seconds_since(t0);
+        auto img = support::render_mesh_views(device, m.positions, idx, std::span<const support::camera>(&cams[v], 1), vopt);
+        if (!img) return void(std::fprintf(stderr, "views: %s\n", img.error().message().c_str()));
+        auto sim = support::compare_views(*img, std::vector<support::image>{full[v]});
+        if (!sim) return void(std::fprintf(stderr, "views: %s\n", sim.error().message().c_str()));
+        const view_distances d = vertex_distances(m, p.saliency, salient_cut, idx);
+        psnr_sum[method] += sim->psnr;
+        static const char* names[] = {"infolerp", "infolerp_paper", "meshoptimizer"};
+        for (std::FILE* o : {csv, stdout})
+          std::fprintf(o, "view,%s,%s,%.2f,%s,%zu,%.4f,%.6f,%.6g,%.6g,%.6g\n", name.c_str(), names[method], f, view.c_str(),
+                       idx.size() / 3, sim->psnr, sim->ssim, d.weighted, d.salient, sec);
+        std::fflush(csv);
+      }
+      if (v == 7 || v == 15)
+        std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshoptimizer %.2f dB\n", name.c_str(), f,
+                    v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8),
+            psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0;
+    }
+  }
+}
+
 }  // namespace
 
 int pareto_lod(int argc, char** argv) {
   std::string csv_path;
   std::vector<std::string> extra;
   int reps = 5;
-  bool builtin = true, frames = true;
+  bool builtin = true, frames = true, simplify = true, views = true;
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
@@ -266,9 +402,17 @@ int pareto_lod(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--percentile")) g_weighting.amplify_percentile = std::atof(next().c_str());
     else if (!std::strcmp(argv[i], "--only-given")) builtin = false;
     else if (!std::strcmp(argv[i], "--no-frames")) frames = false;
+    else if (!std::strcmp(argv[i], "--no-simplify")) simplify = false;
+    else if (!std::strcmp(argv[i], "--no-views")) views = false;
+    else if (!std::strcmp(argv[i], "--fraction")) g_view_fraction = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--clusters")) g_clusters = static_cast<std::uint32_t>(std::max(1, std::atoi(next().c_str())));
+    else if (!std::strcmp(argv[i], "--hidden")) g_lod.view.hidden_weight = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--silhouette")) g_lod.view.silhouette_weight = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--near")) g_lod.view.near_fraction = std::atof(next().c_str());
     else {
       std::fprintf(stderr, "usage: infolerp_pareto lod --csv FILE [--mesh PATH]... [--reps N] [--amplification A]"
-                   " [--percentile P] [--only-given] [--no-frames]\n");
+                   " [--percentile P] [--only-given] [--no-frames] [--no-simplify] [--no-views] [--fraction F] [--hidden W]"
+                   " [--silhouette W] [--near F] [--clusters N]\n");
       return 2;
     }
   }
@@ -279,6 +423,8 @@ int pareto_lod(int argc, char** argv) {
   std::FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (!csv) return std::fprintf(stderr, "cannot write %s\n", csv_path.c_str()), 1;
   std::fprintf(csv, "kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr,ssim\n");
+  if (views)
+    std::fprintf(csv, "kind,mesh,method,fraction,view,triangles,psnr_db,ssim,weighted_distance,salient_distance,seconds\n");
   std::vector<std::pair<std::string, std::string>> meshes;
   if (builtin)
     for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));
@@ -295,7 +441,8 @@ int pareto_lod(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), m.error().message().c_str());
       continue;
     }
-    simplify_rows(csv, device, name, *m, reps);
+    if (simplify) simplify_rows(csv, device, name, *m, reps);
+    if (views) view_rows(csv, device, name, *m);
   }
   if (frames) frame_rows(csv, reps);
   std::fclose(csv);

@@ -132,7 +132,10 @@ inline bool stage_lod(demo_context& ctx) {
     const auto budget = std::min<std::uint64_t>(lod->capacity(), static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(nt) / 2.0));
     detail::lod_panel ours{std::string("lod-saliency-") + label, std::vector<std::uint32_t>(contracted_index_bound(*h)), 0.0, {}};
     const auto t0 = clk::now();
-    auto st = lod->frame(glm::dvec3(cam.eye), budget, ours.indices, ranges);
+    const lod_camera eye{glm::dvec3(cam.eye), glm::dvec3(cam.target - cam.eye), glm::dvec3(cam.up),
+                         static_cast<double>(cam.vertical_fov_degrees) * 3.141592653589793 / 180.0, static_cast<std::uint32_t>(side),
+                         static_cast<std::uint32_t>(side)};
+    auto st = lod->frame(eye, budget, ours.indices, ranges);
     ours.seconds = std::chrono::duration<double>(clk::now() - t0).count();
     if (!st) return report(st.error()), false;
     ours.indices.resize(st->indices);

@@ -13,19 +13,22 @@ TEST_CASE("a frame allocates nothing after setup", "[lod]") {
   std::vector<std::uint32_t> cl(m.triangle_count());
   for (std::size_t t = 0; t < cl.size(); ++t) cl[t] = static_cast<std::uint32_t>(t % 5);
   std::vector<double> sal(m.vertex_count(), 1.0), w(3 * m.triangle_count(), 1.0);
-  auto h = make_contraction_hierarchy(m, w, cl, 5);
+  auto h = make_contraction_hierarchy(m, w, cl, 5, {.cluster_local_first = true});
   REQUIRE(h.ok());
   auto table = compute_cluster_attributes(m, sal, cl, 5);
   REQUIRE(table.ok());
   auto lod = view_dependent_lod::create(*h, *table);
+  auto paper = view_dependent_lod::create(*h, *table, {.selection = lod_selection::paper, .view = {}});
   REQUIRE(lod.ok());
+  REQUIRE(paper.ok());
   std::vector<std::uint32_t> out(contracted_index_bound(*h));
   std::vector<index_range> ranges(5);
+  const lod_camera camera{{0.2, 3.0, 1.0}, {-0.2, -3.0, -1.0}, {0.0, 0.0, 1.0}, 0.8, 640, 480};
   const std::size_t before = support::heap_allocations.load();
   bool ok = true;
   for (std::uint64_t r : {std::uint64_t{10}, std::uint64_t{h->local_contractions}, lod->capacity() - 1}) {
-    auto st = lod->frame(glm::dvec3(0.2, 3.0, 1.0), r, out, ranges);
-    ok = ok && st.ok();
+    ok = ok && lod->frame(camera, r, out, ranges).ok();
+    ok = ok && paper->frame(camera, r, out, ranges).ok();
   }
   const std::size_t during = support::heap_allocations.load() - before;
   REQUIRE(ok);

@@ -71,6 +71,10 @@ TEST_CASE("budget distribution (eq. 9) by hand") {
   auto full = infolerp::distribute_contractions(priority, capacity, 1000);
   REQUIRE(full.ok());
   CHECK(*full == std::vector<std::uint64_t>{100, 5, 100});
+  // The largest target: λ_perc · 2^64 cannot be cast to an integer; every cluster still fills.
+  auto most = infolerp::distribute_contractions(priority, capacity, UINT64_MAX);
+  REQUIRE(most.ok());
+  CHECK(*most == std::vector<std::uint64_t>{100, 5, 100});
   // A small target: the step rounds up to 1, the two least important clusters take one each.
   auto small = infolerp::distribute_contractions(priority, capacity, 2);
   CHECK(*small == std::vector<std::uint64_t>{0, 1, 1});

@@ -36,12 +36,21 @@ camera mesh_view_camera(unsigned k, unsigned views, std::span<const glm::vec3> p
 
 result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
                                              std::span<const std::uint32_t> indices, const mesh_view_options& opt) {
+  const bounding_box box = box_of(positions);
+  std::vector<camera> cams(opt.views);
+  for (unsigned k = 0; k < opt.views; ++k) cams[k] = view_camera(k, opt.views, box.center(), 0.5 * box.diagonal());
+  return render_mesh_views(device, positions, indices, cams, opt);
+}
+
+result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
+                                             std::span<const std::uint32_t> indices, std::span<const camera> cameras,
+                                             const mesh_view_options& opt) {
   if (indices.empty() || indices.size() % 3 != 0)
     return make_error(errc::bad_size, indices.size(), "render_mesh_views: ", indices.size(),
                       " indices is not a positive multiple of 3");
-  if (opt.width <= 0 || opt.height <= 0 || opt.views == 0)
+  if (opt.width <= 0 || opt.height <= 0 || cameras.empty())
     return make_error(errc::bad_parameter, no_element, "render_mesh_views: size ", opt.width, "x", opt.height, " and ",
-                      opt.views, " views must be positive");
+                      cameras.size(), " views must be positive");
   indexed_mesh m;
   m.positions.assign(positions.begin(), positions.end());
   m.triangles.resize(indices.size() / 3);
@@ -61,9 +70,9 @@ result<std::vector<image>> render_mesh_views(const embree_device& device, std::s
   scene.objects.push_back({"mesh", std::move(m), {texture_kind::solid, {0.75f, 0.72f, 0.68f}, {}, {1.0f, 1.0f}, 0.3f}});
   scene.ao_radius = static_cast<float>(0.4 * r);
   scene.ray_offset = static_cast<float>(1e-4 * r);
-  std::vector<image> out(opt.views);
-  for (unsigned k = 0; k < opt.views; ++k) {
-    scene.view = view_camera(k, opt.views, box.center(), r);
+  std::vector<image> out(cameras.size());
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    scene.view = cameras[k];
     const glm::vec3 fwd = glm::normalize(scene.view.target - scene.view.eye);
     const glm::vec3 right = glm::normalize(glm::cross(fwd, scene.view.up)), up = glm::cross(right, fwd);
     scene.sun = {glm::normalize(-fwd - 0.6f * right + 0.8f * up), {1.0f, 0.92f, 0.8f}};

@@ -34,6 +34,11 @@ camera mesh_view_camera(unsigned k, unsigned views, std::span<const glm::vec3> p
 result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
                                              std::span<const std::uint32_t> indices, const mesh_view_options& opt = {});
 
+// The same from the given cameras (opt.views unused).
+result<std::vector<image>> render_mesh_views(const embree_device& device, std::span<const glm::vec3> positions,
+                                             std::span<const std::uint32_t> indices, std::span<const camera> cameras,
+                                             const mesh_view_options& opt = {});
+
 struct view_similarity {
   double psnr = 0.0;  // mean over the views of support::psnr (dB, 8-bit display values)
   double ssim = 0.0;  // mean over the views of the SSIM of display luma

@@ -10,9 +10,15 @@
 // decides the order. Order: global by (cost, u, v), one heap entry per vertex (its cheapest
 // allowed contraction, updated in place); refused: non-manifold or duplicate results (link
 // condition), a normal turning past acos(min_normal_cos), a boundary vertex leaving its boundary.
-// Cluster-local phase (cluster_local_first): contractions whose vertices and 1-rings lie in one
-// cluster run first, so clusters simplify independently and neighbour matching does not drag
-// every cluster to the coarsest; then the whole mesh, down to backstop × V vertices (paper: 1%).
+// Floor: a weight below weight_floor × the mean weight counts as that (all weights 1 when the
+// mean is 0), so that a region of zero saliency (a floor, a wall) keeps its feature and boundary
+// planes instead of collapsing at no cost.
+// Cluster-local phase (cluster_local_first, for the paper's eq. 9 selection): contractions whose
+// vertices and 1-rings lie in one cluster run first, so clusters simplify independently and
+// neighbour matching does not drag every cluster to the coarsest; then the whole mesh, down to
+// backstop × V vertices (paper: 1%). Off by default: run to exhaustion, the phase leaves
+// full-resolution bands along cluster borders, and view_dependent_lod's default selection
+// does better on one global order (benchmarks/NOTES.md).
 //
 // Hierarchy, per contraction i: removed[i], target[i], parent[i] (the last contraction that
 // changed the fan of u, v or a neighbour; no_parent if none), its owning cluster (that of the
@@ -47,7 +53,8 @@ struct simplification_options {
   double backstop = 0.01;         // stop when this fraction of the vertices is left, in [0, 1]
   double boundary_weight = 10.0;  // weight of the planes that hold mesh-boundary edges, >= 0
   double min_normal_cos = 0.0;    // a triangle's normal may turn by at most acos of this, in [0, 1)
-  bool cluster_local_first = true;  // first only contractions whose 2-ring lies in one cluster (see above)
+  bool cluster_local_first = false;  // first only contractions whose 2-ring lies in one cluster (see above)
+  double weight_floor = 0.1;      // weights below this fraction of their mean count as it, in [0, 1] (see above)
 };
 
 struct cross_dependency {
@@ -331,11 +338,17 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     return make_error(errc::bad_parameter, no_element, "backstop ", opt.backstop, " must be in [0, 1]");
   if (!(opt.min_normal_cos >= 0.0 && opt.min_normal_cos < 1.0))
     return make_error(errc::bad_parameter, no_element, "min_normal_cos ", opt.min_normal_cos, " must be in [0, 1)");
+  if (!(opt.weight_floor >= 0.0 && opt.weight_floor <= 1.0))
+    return make_error(errc::bad_parameter, no_element, "weight_floor ", opt.weight_floor, " must be in [0, 1]");
   if (!(opt.boundary_weight >= 0.0) || !std::isfinite(opt.boundary_weight))
     return make_error(errc::bad_parameter, no_element, "boundary_weight ", opt.boundary_weight, " must be >= 0 and finite");
   if (nt >= (std::size_t{1} << 32) / 3 || nv >= invalid_id)
     return make_error(errc::unsupported, nt, "mesh has ", nv, " vertices and ", nt, " triangles; at most 4294967294 and 1431655764 are supported");
 
+  double mean_weight = 0.0;  // sum of weight / count, overflow-free for finite weights
+  for (std::size_t k = 0; k < weights.size(); ++k) mean_weight += weights[k] / static_cast<double>(weights.size());
+  const double floor_weight = mean_weight > 0.0 ? opt.weight_floor * mean_weight : 1.0;
+  const auto weight = [&](std::size_t k) { return mean_weight > 0.0 ? std::max(weights[k], floor_weight) : 1.0; };
   detail::collapse_mesh cm;
   cm.pos.resize(nv);
   for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = mesh_position(m, v);
@@ -364,7 +377,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     const glm::dvec3 n = n2 / len;
     const double d = -glm::dot(n, p0), area = 0.5 * len;
     for (int j = 0; j < 3; ++j) {
-      cm.q[f[j]].add_plane(n, d, area * weights[3 * t + static_cast<std::size_t>(j)]);
+      cm.q[f[j]].add_plane(n, d, area * weight(3 * t + static_cast<std::size_t>(j)));
       cm.q[f[j]].area += area;
     }
   }
@@ -421,7 +434,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
         if (!(len > 0.0)) continue;
         const glm::dvec3 n = pn / len;
         const double d = -glm::dot(n, cm.at(a));
-        const double w = opt.boundary_weight * glm::dot(ev, ev) * (weights[3 * t] + weights[3 * t + 1] + weights[3 * t + 2]) / 3.0;
+        const double w = opt.boundary_weight * glm::dot(ev, ev) * (weight(3 * t) + weight(3 * t + 1) + weight(3 * t + 2)) / 3.0;
         cm.q[a].add_plane(n, d, w);
         cm.q[b].add_plane(n, d, w);
       }

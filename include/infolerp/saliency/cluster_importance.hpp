@@ -1,7 +1,7 @@
 #pragma once
 // View-dependent cluster importance and budget distribution (salient-clustering paper §IV.A,
 // eqs. 5–9). Per cluster (precomputed once): centroid, area, mean normal, peak normal deviation,
-// bounding radius, total/mean/peak saliency. Per view:
+// normal spread (for screen_error_selection.hpp), bounding radius, total/mean/peak saliency. Per view:
 //   λ_angle = ∠(v_cam, μ(n_c)) − peak(n_c)          (eq. 5; v_cam from the camera to the centroid,
 //                                                    radians, clamped at 0: "very low" visibility)
 //   λ_dist  = |x̄_c − p_cam| − r_c                    (eq. 6)
@@ -39,6 +39,7 @@ struct cluster_attributes {
   double area = 0.0;               // total face area
   glm::dvec3 mean_normal{0.0};     // unit area-weighted mean normal (0 when the normals cancel)
   double peak_normal_deviation = 0.0;  // largest angle (radians) between a face normal and mean_normal
+  double normal_spread = 0.0;      // acos of the area-weighted mean resultant length of the face normals (0: flat)
   double radius = 0.0;             // bounding sphere about centroid (farthest corner)
   double total_saliency = 0.0;     // Σ face saliency
   double mean_saliency = 0.0;      // total / faces
@@ -87,6 +88,7 @@ result<cluster_table> compute_cluster_attributes(const M& m, std::span<const dou
     if (c.area > 0.0) c.centroid = csum[k] / c.area;
     const double len = glm::length(nsum[k]);
     if (len > 0.0) c.mean_normal = nsum[k] / len;
+    c.normal_spread = c.area > 0.0 ? std::acos(std::clamp(0.5 * len / c.area, 0.0, 1.0)) : 0.0;
     if (c.faces) c.mean_saliency = c.total_saliency / c.faces;
   }
   for (std::size_t t = 0; t < nt; ++t) {
@@ -177,8 +179,10 @@ inline status distribute_contractions(std::span<const double> priority, std::spa
   // std::sort does not allocate; equal priorities keep index order (the comparison includes it).
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return priority[a] < priority[b] || (priority[a] == priority[b] && a < b); });
-  const auto step = std::max<std::uint64_t>(
-      1, static_cast<std::uint64_t>(std::ceil(lambda_perc * static_cast<double>(global_target))));
+  // A portion at or above 2^64 (global_target near UINT64_MAX) cannot be cast: it is the whole target.
+  const double portion = std::ceil(lambda_perc * static_cast<double>(global_target));
+  const std::uint64_t step =
+      portion >= 18446744073709551616.0 ? global_target : std::max<std::uint64_t>(1, static_cast<std::uint64_t>(portion));
   std::fill(out.begin(), out.end(), std::uint64_t{0});
   std::uint64_t remaining = global_target;
   bool progress = true;

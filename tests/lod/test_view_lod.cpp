@@ -1,0 +1,237 @@
+// The default view-dependent selection (screen_error_selection.hpp through view_dependent_lod):
+// any valid camera gets a crack-free LOD, bad cameras get a clear status, zero saliency keeps
+// its planes (the weight floor of contraction_hierarchy.hpp).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <vector>
+#include <catch2/catch.hpp>
+#include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/view_dependent_lod.hpp"
+#include "infolerp/lod/weighting_map.hpp"
+#include "infolerp/saliency/mesh_saliency.hpp"
+#include "infolerp/saliency/salient_clustering.hpp"
+#include "support/mesh_io.hpp"
+#include "support/procedural.hpp"
+
+using namespace infolerp;
+
+namespace {
+
+// Every undirected edge used by exactly two triangles, once in each direction, no repeated index.
+bool closed_and_manifold(std::span<const std::uint32_t> idx) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  for (std::size_t k = 0; k < idx.size(); k += 3) {
+    if (idx[k] == idx[k + 1] || idx[k + 1] == idx[k + 2] || idx[k] == idx[k + 2]) return false;
+    for (std::size_t j = 0; j < 3; ++j) ++directed[{idx[k + j], idx[k + (j + 1) % 3]}];
+  }
+  for (const auto& [e, n] : directed) {
+    auto it = directed.find({e.second, e.first});
+    if (n != 1 || it == directed.end() || it->second != 1) return false;
+  }
+  return true;
+}
+
+std::vector<std::uint32_t> octants(const indexed_mesh& m) {
+  std::vector<std::uint32_t> c(m.triangle_count());
+  for (std::size_t t = 0; t < c.size(); ++t) {
+    const glm::dvec3 x = triangle_centroid(corners(m, t));
+    c[t] = (x.x > 0 ? 1u : 0u) | (x.y > 0 ? 2u : 0u) | (x.z > 0 ? 4u : 0u);
+  }
+  return c;
+}
+
+struct sphere_lod {
+  indexed_mesh m = support::make_icosphere(3);
+  std::vector<std::uint32_t> cl = octants(m);
+  std::vector<double> sal;
+  contraction_hierarchy h;
+  cluster_table table;
+  sphere_lod() {
+    sal.resize(m.vertex_count());
+    for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 1.0 + 0.5 * std::sin(3.0 * m.positions[v].x);
+    auto w = weighting_map(m, sal, cl, 8);
+    auto hh = make_contraction_hierarchy(m, *w, cl, 8, {.cluster_local_first = false});
+    auto t = compute_cluster_attributes(m, sal, cl, 8);
+    REQUIRE(hh.ok());
+    REQUIRE(t.ok());
+    h = std::move(*hh), table = std::move(*t);
+  }
+};
+
+lod_camera look_at(const glm::dvec3& eye, const glm::dvec3& at) { return {eye, at - eye, {0.0, 0.0, 1.0}, 0.8, 256, 256}; }
+
+}  // namespace
+
+TEST_CASE("view LOD: random cameras, inside the mesh included, get crack-free LODs within budget", "[lod]") {
+  const sphere_lod s;
+  auto lod = view_dependent_lod::create(s.h, s.table);
+  REQUIRE(lod.ok());
+  std::vector<std::uint32_t> out(contracted_index_bound(s.h));
+  std::vector<index_range> ranges(8);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> pos(-3.0, 3.0), unit(-1.0, 1.0);
+  std::uniform_int_distribution<std::uint64_t> budget(0, lod->capacity());
+  for (int k = 0; k < 40; ++k) {
+    // Every fourth camera inside the sphere (and inside every cluster's bounding sphere).
+    const glm::dvec3 eye = k % 4 == 0 ? 0.3 * glm::dvec3(unit(rng), unit(rng), unit(rng)) : glm::dvec3(pos(rng), pos(rng), pos(rng));
+    lod_camera cam = look_at(eye, glm::dvec3(unit(rng), unit(rng), unit(rng)));
+    if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-3) continue;
+    const std::uint64_t r = k == 1 ? lod->capacity() : budget(rng);
+    auto st = lod->frame(cam, r, out, ranges);
+    if (!st.ok()) FAIL(st.error().message());
+    INFO("camera " << k << ", budget " << r << " of " << lod->capacity());
+    CHECK(st->applied <= r);
+    CHECK(st->applied + lod->capacity() / 1000 + 8 >= st->budgeted);
+    const std::span<const std::uint32_t> idx(out.data(), st->indices);
+    CHECK(closed_and_manifold(idx));
+    if (r > 100) CHECK(st->indices < 3 * s.m.triangle_count());
+    std::size_t sum = 0;
+    for (const index_range& g : ranges) sum += g.count;
+    CHECK(sum == st->indices);
+  }
+}
+
+TEST_CASE("view LOD: a camera inside the mesh gets the same LOD as the paper option refused", "[lod]") {
+  const sphere_lod s;
+  for (lod_selection sel : {lod_selection::screen_error, lod_selection::paper}) {
+    auto lod = view_dependent_lod::create(s.h, s.table, {.selection = sel, .view = {}});
+    REQUIRE(lod.ok());
+    std::vector<std::uint32_t> out(contracted_index_bound(s.h));
+    std::vector<index_range> ranges(8);
+    auto st = lod->frame(look_at({0.0, 0.0, 0.0}, {1.0, 0.2, 0.1}), lod->capacity() / 2, out, ranges);
+    if (!st.ok()) FAIL(st.error().message());
+    CHECK(st->indices < 3 * s.m.triangle_count());
+    CHECK(st->indices > 0);
+    CHECK(closed_and_manifold(std::span<const std::uint32_t>(out.data(), st->indices)));
+  }
+}
+
+TEST_CASE("view LOD: bad cameras get a clear status", "[lod]") {
+  const sphere_lod s;
+  auto lod = view_dependent_lod::create(s.h, s.table);
+  REQUIRE(lod.ok());
+  std::vector<std::uint32_t> out(contracted_index_bound(s.h));
+  std::vector<index_range> ranges(8);
+  const lod_camera good = look_at({0.0, -4.0, 1.0}, {0.0, 0.0, 0.0});
+  REQUIRE(lod->frame(good, 10, out, ranges).ok());
+  auto bad = [&](lod_camera c) { return lod->frame(c, 10, out, ranges).error(); };
+  lod_camera c = good;
+  c.position.x = std::nan("");
+  CHECK(bad(c).code() == errc::bad_parameter);
+  CHECK_THAT(bad(c).message(), Catch::Contains("position"));
+  c = good, c.width = 0;
+  CHECK(bad(c).code() == errc::bad_size);
+  CHECK_THAT(bad(c).message(), Catch::Contains("viewport"));
+  c = good, c.height = 0;
+  CHECK(bad(c).code() == errc::bad_size);
+  c = good, c.forward = glm::dvec3(0.0);
+  CHECK(bad(c).code() == errc::bad_parameter);
+  CHECK_THAT(bad(c).message(), Catch::Contains("forward"));
+  c = good, c.up = c.forward;
+  CHECK_THAT(bad(c).message(), Catch::Contains("parallel"));
+  c = good, c.vertical_fov = 0.0;
+  CHECK_THAT(bad(c).message(), Catch::Contains("vertical_fov"));
+  c = good, c.vertical_fov = std::nan("");
+  CHECK(bad(c).code() == errc::bad_parameter);
+  CHECK(lod->frame(good, lod->capacity() + 1, out, ranges).error().code() == errc::bad_parameter);
+  CHECK(view_dependent_lod::create(s.h, s.table, {.view = {.hidden_weight = 0.0}}).error().code() == errc::bad_parameter);
+  CHECK(view_dependent_lod::create(s.h, s.table, {.view = {.silhouette_weight = 0.5}}).error().code() == errc::bad_parameter);
+  CHECK(make_contraction_hierarchy(s.m, std::vector<double>(3 * s.m.triangle_count(), 1.0), s.cl, 8, {.weight_floor = 2.0})
+            .error()
+            .code() == errc::bad_parameter);
+}
+
+TEST_CASE("view LOD: a flat L-shaped sheet, half of it of zero saliency, keeps its area at 50%", "[lod]") {
+  // 40 x 40 unit cells without the quadrant x, y >= 20: 1,200 units of area, two clusters.
+  indexed_mesh m;
+  std::map<std::pair<int, int>, std::uint32_t> id;
+  auto vertex = [&](int x, int y) {
+    auto [it, fresh] = id.try_emplace({x, y}, static_cast<std::uint32_t>(m.positions.size()));
+    if (fresh) m.positions.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
+    return it->second;
+  };
+  std::vector<std::uint32_t> cl;
+  for (int x = 0; x < 40; ++x)
+    for (int y = 0; y < 40; ++y) {
+      if (x >= 20 && y >= 20) continue;
+      const std::uint32_t a = vertex(x, y), b = vertex(x + 1, y), c = vertex(x + 1, y + 1), d = vertex(x, y + 1);
+      m.triangles.push_back({a, b, c});
+      m.triangles.push_back({a, c, d});
+      cl.insert(cl.end(), 2, x < 20 ? 0u : 1u);
+    }
+  // Saliency 0 on cluster 0's vertices (x <= 20), 1 beyond; without smoothing cluster 0's
+  // weights are all 0, so only the floor keeps its corners and borders.
+  std::vector<double> sal(m.vertex_count(), 0.0);
+  for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = m.positions[v].x > 20.5f ? 1.0 : 0.0;
+  auto w = weighting_map(m, sal, cl, 2, {.smoothing_scale = 0.0});
+  REQUIRE(w.ok());
+  auto h = make_contraction_hierarchy(m, *w, cl, 2, {.cluster_local_first = false});
+  auto table = compute_cluster_attributes(m, sal, cl, 2);
+  REQUIRE(h.ok());
+  REQUIRE(table.ok());
+  auto lod = view_dependent_lod::create(*h, *table);
+  REQUIRE(lod.ok());
+  std::vector<std::uint32_t> out(contracted_index_bound(*h));
+  std::vector<index_range> ranges(2);
+  auto st = lod->frame(look_at({20.0, -30.0, 40.0}, {20.0, 20.0, 0.0}), 600, out, ranges);
+  for (std::uint64_t r = 600; st.ok() && st->indices > 3 * 1200 && r + 10 <= lod->capacity(); r += 10)
+    st = lod->frame(look_at({20.0, -30.0, 40.0}, {20.0, 20.0, 0.0}), r, out, ranges);
+  if (!st.ok()) FAIL(st.error().message());
+  REQUIRE(st->indices <= 3 * 1200);  // half of the 2,400 triangles
+  double area = 0.0;
+  bool flipped = false, outside = false;
+  for (std::size_t k = 0; k < st->indices; k += 3) {
+    const glm::dvec3 a(m.positions[out[k]]), b(m.positions[out[k + 1]]), c(m.positions[out[k + 2]]);
+    const double z = 0.5 * glm::cross(b - a, c - a).z;
+    flipped = flipped || z <= 0.0;
+    area += z;
+    const glm::dvec3 g = (a + b + c) / 3.0;
+    outside = outside || (g.x > 20.0 && g.y > 20.0);
+  }
+  // With every triangle upright and inside the L, the covered area equals 1,200 only if the
+  // boundary is kept: Hausdorff distance 0 up to rounding.
+  CHECK_FALSE(flipped);
+  CHECK_FALSE(outside);
+  CHECK(std::abs(area - 1200.0) <= 1e-6 * std::sqrt(2.0) * 40.0);
+}
+
+TEST_CASE("view LOD: four cameras around armadillo give four different crack-free sets within budget", "[lod][real]") {
+  auto m = support::load_mesh(support::cgal_mesh("armadillo"));
+  REQUIRE(m.ok());
+  auto sal = compute_saliency(*m);
+  REQUIRE(sal.ok());
+  auto cl = salient_clustering(*m, sal->saliency, {.clusters = 10});
+  REQUIRE(cl.ok());
+  auto w = weighting_map(*m, sal->saliency, cl->cluster, cl->count);
+  REQUIRE(w.ok());
+  auto h = make_contraction_hierarchy(*m, *w, cl->cluster, cl->count, {.cluster_local_first = false});
+  auto table = compute_cluster_attributes(*m, sal->saliency, cl->cluster, cl->count);
+  REQUIRE(h.ok());
+  REQUIRE(table.ok());
+  auto lod = view_dependent_lod::create(*h, *table);
+  REQUIRE(lod.ok());
+  const bounding_box box = mesh_bounds(*m);
+  const std::size_t nt = m->triangle_count();
+  std::uint64_t budget = 0;  // the global prefix's contractions down to 10% of the triangles
+  for (std::size_t tris = nt; tris > nt / 10 && budget < lod->capacity(); ++budget) tris -= h->faces_removed[budget];
+  std::vector<std::uint32_t> out(contracted_index_bound(*h));
+  std::vector<index_range> ranges(cl->count);
+  std::vector<std::vector<std::uint32_t>> sets;
+  for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)}) {
+    const glm::dvec3 eye = box.center() + 1.5 * box.diagonal() * dir;
+    auto st = lod->frame({eye, box.center() - eye, {0.0, 1.0, 0.0}, 0.7, 512, 512}, budget, out, ranges);
+    if (!st.ok()) FAIL(st.error().message());
+    INFO("camera direction " << dir.x << " " << dir.y << " " << dir.z << ": " << st->indices / 3 << " triangles");
+    CHECK(st->applied <= budget);
+    CHECK(st->indices / 3 >= nt / 10);
+    CHECK(st->indices / 3 <= nt / 10 + nt / 100);
+    const std::span<const std::uint32_t> ours(out.data(), st->indices);
+    std::vector<std::uint32_t> sorted(ours.begin(), ours.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (const auto& other : sets) CHECK(other != sorted);
+    sets.push_back(std::move(sorted));
+  }
+}
