@@ -1,7 +1,8 @@
 // libFuzzer target: every option of the LOD family at fuzzed values, extremes included
 // (weighting_map_options, simplification_options, view_dependent_lod's lambda_perc and grain,
 // the frame's camera and global contraction count), on small fuzzed meshes.
-// Input: [flags][weighting options][simplification options][lambda_perc][grain][camera x3]
+// Input: [flags][weighting options][simplification options][lambda_perc][grain][camera position x3,
+// looking at the origin]
 // [contractions][mesh][per-vertex saliency][cluster per triangle].
 // Checks: every error names its problem; weights are finite and >= 0; a frame's index buffer fits
 // its bound, has no repeated index in a triangle, and equals the frame of the default grain.
@@ -24,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                             .min_normal_cos = r.real(), .cluster_local_first = (flags & 1) != 0};
   const double lambda_perc = r.real();
   const std::size_t grain = r.count<std::size_t>();
-  const glm::dvec3 camera(r.real(), r.real(), r.real());
+  const glm::dvec3 eye(r.real(), r.real(), r.real());
+  const infolerp::lod_camera camera{.position = eye, .forward = -eye, .width = 64, .height = 64};
   const std::uint64_t contractions = r.count<std::uint64_t>();
   const std::uint32_t clusters = 1u + r.u8() % 3u;
   const infolerp::indexed_mesh m = fuzz::read_mesh(r, 24, 32);
@@ -44,14 +46,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto table = infolerp::compute_cluster_attributes(m, saliency, cluster, clusters);
   fuzz::check_error(table.error());
   if (!table.ok()) return 0;
-  auto lod = infolerp::view_dependent_lod::create(*h, *table, lambda_perc, grain);
+  // flag 4: the paper's selection (eqs. 5-9), else the default screen-error selection.
+  const infolerp::lod_selection sel = (flags & 4) ? infolerp::lod_selection::paper : infolerp::lod_selection::screen_error;
+  infolerp::lod_options opt;
+  opt.selection = sel;
+  opt.lambda_perc = lambda_perc;
+  auto ref = infolerp::view_dependent_lod::create(*h, *table, opt);
+  opt.grain = grain;
+  auto lod = infolerp::view_dependent_lod::create(*h, *table, opt);
   fuzz::check_error(lod.error());
   if (!lod.ok()) return 0;
-  auto ref = infolerp::view_dependent_lod::create(*h, *table, lambda_perc);
   FUZZ_CHECK(ref.ok());
-  // Counts above the capacity are refused; extreme ones near 2^64 are folded (their cast in
-  // cluster_importance.hpp is bounded by that header).
-  const std::uint64_t global = contractions % (lod->capacity() + 2);
+  // Flag 8: the count as read (counts above the capacity are refused, up to 2^64 - 1); else folded
+  // into [0, capacity + 1] so that most inputs draw a frame.
+  const std::uint64_t global = (flags & 8) ? contractions : contractions % (lod->capacity() + 2);
   std::vector<std::uint32_t> out(infolerp::contracted_index_bound(*h)), out_ref(out.size());
   std::vector<infolerp::index_range> ranges(clusters), ranges_ref(clusters);
   auto st = lod->frame(camera, global, out, ranges);

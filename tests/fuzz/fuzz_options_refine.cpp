@@ -4,6 +4,7 @@
 // Input: [flags][subdivision options][criteria options][driver options][camera][fuzzed hit]
 // [mesh]. The image is at most 16 × 16 pixels and a run at most 8 batches, so an input stays
 // cheap. Checks: every error names its problem; every shaded colour is finite.
+#include <cmath>
 #include <vector>
 #include "fuzz_common.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
@@ -29,8 +30,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   c.min_pixels = r.real_f();
   c.always_refine_fraction = r.real_f();
   c.batch = r.count<std::uint32_t>();
-  // rnd_point_fraction is drawn in [0, 1]: criteria.hpp's cast of larger values is bounded there.
-  c.rnd_point_fraction = static_cast<float>(r.unit());
+  // rnd_point_fraction as read when outside [0, 1e6] (refused); valid values folded into [0, 4] so
+  // that an input stays cheap.
+  c.rnd_point_fraction = r.real_f();
+  if (c.rnd_point_fraction >= 0.0f && c.rnd_point_fraction <= 1e6f) c.rnd_point_fraction = std::fmod(c.rnd_point_fraction, 4.0f);
   c.nld_is_pixel_fraction = r.real_f();
   c.random_share = r.real_f();
   c.seed = r.count<std::uint64_t>();

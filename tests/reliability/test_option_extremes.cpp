@@ -176,9 +176,11 @@ outcome run_hierarchy(const simplification_options& o) {
   return {{}, h->contraction_count() < sphere().positions.size()};
 }
 
-// A frame of the per-view LOD with lambda_perc, grain, camera and global contractions (scaled
-// by the capacity when `fraction`), compared with the same frame at the default grain.
-outcome run_lod(double lambda_perc, std::size_t grain, glm::dvec3 camera, double global, bool fraction) {
+// A frame of the per-view LOD with lambda_perc, grain, a camera at `eye` looking at the origin and
+// global contractions (scaled by the capacity when `fraction`), compared with the same frame at
+// the default grain.
+outcome run_lod(double lambda_perc, std::size_t grain, glm::dvec3 eye, double global, bool fraction) {
+  const lod_camera camera{.position = eye, .forward = -eye, .width = 64, .height = 64};
   const std::vector<double> s = bumpy_saliency(sphere());
   const std::vector<std::uint32_t> cl = halves(sphere());
   const std::vector<double> w(3 * sphere().triangles.size(), 1.0);
@@ -186,9 +188,12 @@ outcome run_lod(double lambda_perc, std::size_t grain, glm::dvec3 camera, double
   auto table = compute_cluster_attributes(sphere(), s, cl, 2);
   REQUIRE(h.ok());
   REQUIRE(table.ok());
-  auto lod = view_dependent_lod::create(*h, *table, lambda_perc, grain);
+  lod_options opt;
+  opt.lambda_perc = lambda_perc;
+  auto ref = view_dependent_lod::create(*h, *table, opt);
+  opt.grain = grain;
+  auto lod = view_dependent_lod::create(*h, *table, opt);
   if (!lod) return {lod.error()};
-  auto ref = view_dependent_lod::create(*h, *table, lambda_perc);
   REQUIRE(ref.ok());
   const std::uint64_t r = fraction ? static_cast<std::uint64_t>(0.5 * static_cast<double>(lod->capacity()))
                                    : as_count<std::uint64_t>(global);
@@ -463,6 +468,11 @@ std::vector<option_row> refine_rows() {
        crit([](criteria_options& c, double x) {
          c.criterion = refinement_criterion::nld_is;
          c.nld_is_pixel_fraction = as_float(x);
+       })},
+      {"progressive_refiner", "rnd_point_fraction", true, 0, {1.0000001e6},
+       crit([](criteria_options& c, double x) {
+         c.criterion = refinement_criterion::rnd;
+         c.rnd_point_fraction = as_float(x);
        })},
       {"progressive_refiner", "random_share", true, 0, {1.0000001},
        crit([](criteria_options& c, double x) { c.random_share = as_float(x); })},

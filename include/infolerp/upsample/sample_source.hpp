@@ -2,51 +2,43 @@
 // What the I-Buffer upsampler asks of the engine: a sample source.
 //
 // Paper: "Feature-based clustered geometry for interpolated Ray-casting", §4 and §4.1. Each
-// I-Buffer sample stores "its position, texture coordinates, cluster ID, normal" plus the ratio
-// of occluded samples for soft shadows and ambient occlusion (§4), and hard-shadow light bits
-// "compacted in a single integer value" (§4.1). Texture coordinates are interpolated, never the
-// textured colours (§5, Fig. 12), so a sample becomes a colour only after interpolation.
-// Beyond the paper: the default record's interpolation is perspective-correct when the engine
-// fills inv_depth (1 / view depth): the paper's screen-linear weights misplace texcoords on
-// surfaces seen at an angle.
+// I-Buffer sample stores "its position, texture coordinates, cluster ID, normal", the ratio of
+// occluded samples for soft shadows and ambient occlusion (§4) and hard-shadow light bits in one
+// integer (§4.1). Texture coordinates are interpolated, never textured colours (§5, Fig. 12).
+// Beyond the paper: the default record interpolates perspective-correctly when the engine fills
+// inv_depth (1 / view depth); screen-linear weights misplace texcoords on oblique surfaces.
 //
 // A sample source S models:
 //   typename S::sample_type                               the I-Buffer record (copyable)
-//   sample_type evaluate(uint32_t x, uint32_t y) const    full evaluation (primary ray + the
-//                                                         expensive terms) at pixel (x, y)
+//   sample_type evaluate(uint32_t x, uint32_t y) const    full evaluation at pixel (x, y)
 //   Pixel shade(const sample_type&, uint32_t x, uint32_t y) const     the sample's colour
-// and, as members of S or as free functions found by ADL for sample_type (the default record
-// below has them):
+// and, as members of S or free functions found by ADL (the default record below has them):
 //   bool compatible(const sample_type& a, const sample_type& b)        may a and b be interpolated?
 //   sample_type interpolate(const sample_type& a, const sample_type& b)             the midpoint
 //   sample_type interpolate(const sample_type& a, b, c, d)                          the centre
-// `compatible` must be false between background and geometry, and between samples whose
-// hard-shadow light bits differ; it is meant to be an equivalence relation (same cluster id).
-// evaluate/shade/compatible/interpolate are called concurrently from the executor's threads,
-// so they must be thread-safe for concurrent const calls, and deterministic (the same inputs
-// give the same bits), or the upsampler cannot promise identical output across thread counts.
-// Pixel coordinates may lie outside the image, up to 2^(passes-1) - 1 beyond its right and
-// bottom edge (the cropped border of §4); a pinhole camera extrapolates naturally.
+// `compatible` is false between background and geometry and between differing light bits; it is
+// meant to be an equivalence relation (same cluster id). All four are called concurrently from
+// the executor's threads: thread-safe for const calls and deterministic, or the output differs
+// across thread counts. Pixels may lie up to 2^(passes-1) - 1 beyond the right and bottom edge
+// (the cropped border of §4); a pinhole camera extrapolates naturally.
 //
-// Optionally, a probe (the CPU counterpart of a rasteriser's per-pixel cluster-ID buffer): the
-// cheap, sharp part of a sample at every pixel, the expensive, smooth part interpolated:
-//   sample_type probe(uint32_t x, uint32_t y) const      primary hit: cluster id and what comes
-//        cheaply with it (position, normal, texcoords, hard-shadow bits); occlusion left unset
+// Optionally, a probe (the CPU counterpart of a rasteriser's cluster-ID buffer): the cheap, sharp
+// part of a sample at every pixel, the expensive, smooth part interpolated:
+//   sample_type probe(uint32_t x, uint32_t y) const      primary hit: cluster id, position,
+//        normal, texcoords, hard-shadow bits; occlusion left unset
 //   sample_type interpolate(const sample_type& probe, a, b)  /  (probe, a, b, c, d)
 //        the probe completed with the expensive terms of its sources (member or ADL)
-//   bool probe_compatible(const sample_type& probe, const sample_type& s)   optional (member or
-//        ADL; default compatible): for probes that leave out part of what compatible() compares
+//   bool probe_compatible(const sample_type& probe, const sample_type& s)   optional (default
+//        compatible): for probes that leave out part of what compatible() compares
 //   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const   optional:
-//        adds what the probe left out (e.g. hard-shadow rays) so that compatible() then holds
-//        exactly as for the full evaluation; the upsampler calls it only where the agreeing,
-//        bracketing sources do not suffice (upsampler.hpp)
+//        adds what the probe left out so that compatible() holds as for a full evaluation; called
+//        only where the agreeing, bracketing sources do not suffice (upsampler.hpp)
 //
-// Optionally, beyond the paper (adaptive refinement on top of the §4 test):
-//   bool agree(const sample_type& a, const sample_type& b) const   (member: a tolerance is the
-//        source's state) e.g. expensive terms within a tolerance (occlusion_within below); a new
-//        sample is evaluated unless every pair of its sources agrees. Need not be transitive
-//        (all pairs are tested); symmetric, thread-safe and deterministic like compatible(). A
-//        source that always agrees gives exactly the frame of one without agree().
+// Optionally, beyond the paper: bool agree(const sample_type& a, const sample_type& b) const
+// (member: a tolerance is the source's state), e.g. expensive terms within a tolerance
+// (occlusion_within below); a new sample is evaluated unless every pair of its sources agrees.
+// Symmetric, thread-safe and deterministic like compatible(), need not be transitive. A source
+// that always agrees gives exactly the frame of one without agree().
 #include <array>
 #include <concepts>
 #include <cstddef>
