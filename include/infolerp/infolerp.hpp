@@ -49,6 +49,7 @@
 #include "infolerp/lod/weighting_map.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
 #include "infolerp/lod/view_selection.hpp"
+#include "infolerp/lod/screen_error_selection.hpp"
 #include "infolerp/lod/vertex_contraction.hpp"
 #include "infolerp/lod/cluster_split.hpp"
 #include "infolerp/mesh/support_function.hpp"

@@ -46,6 +46,16 @@ std::vector<glm::vec3> image_of(const progressive_refiner& r) {
   return img;
 }
 
+// Takes every outstanding request, shades it and delivers the colours in one call.
+void deliver_all(progressive_refiner& r) {
+  std::vector<shading_point> req;
+  r.take_requests(req);
+  std::vector<std::uint32_t> ids;
+  std::vector<glm::vec3> colours;
+  for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
+  REQUIRE(r.deliver(ids, colours).ok());
+}
+
 bool same_bits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
@@ -420,12 +430,7 @@ std::uint64_t walk_fingerprint(refinement_criterion c, bool restart) {
     REQUIRE((restart ? r.start(scene(), cam, ex) : r.set_view(scene(), cam, ex)).ok());
     take();
     for (;;) {
-      std::vector<shading_point> req;
-      r.take_requests(req);
-      std::vector<std::uint32_t> ids;
-      std::vector<glm::vec3> colours;
-      for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
-      REQUIRE(r.deliver(ids, colours).ok());
+      deliver_all(r);
       take();
       if (r.refine({}, ex) != refine_progress::refined) break;
     }
@@ -466,12 +471,7 @@ TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the curr
     sent = 0;
     take();
     for (;;) {
-      std::vector<shading_point> req;
-      r.take_requests(req);
-      std::vector<std::uint32_t> ids;
-      std::vector<glm::vec3> colours;
-      for (const shading_point& sp : req) ids.push_back(sp.vertex), colours.push_back(shader()(sp));
-      REQUIRE(r.deliver(ids, colours).ok());
+      deliver_all(r);
       take();
       if (r.refine({}, ex) != refine_progress::refined) break;
       take();

@@ -67,18 +67,21 @@ struct pinhole_camera {
   std::uint32_t width = 320;           // image width in pixels
   std::uint32_t height = 240;          // image height in pixels
 
-  // The unit view direction, scaled before normalising so that any finite eye and target whose
-  // difference is a finite float give one (their squared distance may overflow); (0,0,0) when
-  // they coincide or the difference overflows.
-  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) {
-    const glm::vec3 d = target - eye;
+  // d / |d|: glm::normalize where the squared length is a normal float (so ordinary cameras keep
+  // their bits), scaled by the largest component first where it over- or underflows; (0,0,0)
+  // for a zero or non-finite d.
+  [[nodiscard]] static glm::vec3 unit(const glm::vec3& d) {
+    const float l2 = glm::dot(d, d);
+    if (std::isfinite(l2) && l2 >= std::numeric_limits<float>::min()) return glm::normalize(d);
     const float scale = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
     return scale > 0.0f && std::isfinite(scale) ? glm::normalize(d / scale) : glm::vec3(0.0f);
   }
+  // The unit view direction; (0,0,0) when eye and target coincide or target - eye overflows.
+  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) { return unit(target - eye); }
 
   [[nodiscard]] ray primary_ray(std::uint32_t x, std::uint32_t y) const {
     const glm::vec3 f = forward(eye, target);
-    const glm::vec3 r = glm::normalize(glm::cross(f, forward(glm::vec3(0.0f), up)));
+    const glm::vec3 r = unit(glm::cross(f, up));
     const glm::vec3 u = glm::cross(r, f);
     const float h = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
     const float aspect = float(width) / float(height);
@@ -438,7 +441,7 @@ class progressive_refiner {
       const glm::vec3 f = pinhole_camera::forward(e, t);
       if (f == glm::vec3(0.0f))
         return make_error(errc::bad_parameter, no_element, "camera eye and target are too far apart: target - eye overflows float");
-      if (!(glm::length(glm::cross(f, pinhole_camera::forward(glm::vec3(0.0f), u))) > 1e-6f))
+      if (!(glm::length(glm::cross(f, pinhole_camera::unit(u))) > 1e-6f))
         return make_error(errc::bad_parameter, no_element, "camera up is zero or parallel to the view direction");
       const float fov = camera.vertical_fov_degrees;
       if (!(fov > 0.0f && fov < 180.0f))
