@@ -114,8 +114,7 @@ result<seam_clustering> split_at_uv_seams(const M& m, std::span<const std::uint3
     return make_error(errc::bad_size, cluster_of.size(), "split_at_uv_seams: ", cluster_of.size(), " cluster ids for ",
                       nt, " triangles");
   for (std::size_t v = 0; v < nv; ++v) {
-    const glm::vec3 p = mesh_position(m, v);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    if (!all_finite(mesh_position(m, v)))
       return make_error(errc::non_finite, v, "split_at_uv_seams: vertex ", v, " has a non-finite position");
   }
   for (std::size_t t = 0; t < nt; ++t) {
@@ -133,7 +132,7 @@ result<seam_clustering> split_at_uv_seams(const M& m, std::span<const std::uint3
   if (uv)
     for (std::size_t t = 0; t < nt; ++t)
       for (unsigned c = 0; c < 3; ++c)
-        if (const glm::vec2 w = texcoord(t, c); !std::isfinite(w.x) || !std::isfinite(w.y))
+        if (!all_finite(texcoord(t, c)))
           return make_error(errc::non_finite, t, "split_at_uv_seams: triangle ", t, " corner ", c, " has a non-finite texcoord");
 
   const detail::welded_triangles welded = detail::weld_by_position(m);

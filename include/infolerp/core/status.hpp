@@ -4,6 +4,7 @@
 // returns a status whose message names the offending element (triangle 17, bin 3, ...).
 #include <cassert>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -131,5 +132,18 @@ status make_error(errc code, std::uint64_t element, const Parts&... parts) {
   (detail::append_part(message, parts), ...);
   return status(code, std::move(message), element);
 }
+
+// Input checks shared by the entry points. all_finite: every component of a GLM vector (any
+// type with a static length() and operator[]) is finite. O(components).
+template <class V>
+  requires requires { V::length(); }
+[[nodiscard]] bool all_finite(const V& v) {
+  for (decltype(V::length()) i = 0; i < V::length(); ++i)
+    if (!std::isfinite(v[i])) return false;
+  return true;
+}
+// The code for a value that must be finite and >= 0 but is not: non_finite for NaN or ±Inf,
+// bad_parameter for a finite negative value.
+[[nodiscard]] inline errc non_negative_errc(double x) { return std::isfinite(x) ? errc::bad_parameter : errc::non_finite; }
 
 }  // namespace infolerp

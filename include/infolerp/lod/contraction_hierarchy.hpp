@@ -328,7 +328,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
   for (std::size_t k = 0; k < weights.size(); ++k)
     if (!(weights[k] >= 0.0) || !std::isfinite(weights[k]))
-      return make_error(std::isfinite(weights[k]) ? errc::bad_parameter : errc::non_finite, k, "weight of corner ", k % 3, " of triangle ", k / 3, " is ", weights[k],
+      return make_error(non_negative_errc(weights[k]), k, "weight of corner ", k % 3, " of triangle ", k / 3, " is ", weights[k],
                         "; must be finite and >= 0");
   for (std::size_t t = 0; t < nt; ++t)
     if (cluster[t] >= cluster_count)

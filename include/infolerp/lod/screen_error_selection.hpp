@@ -59,9 +59,8 @@ struct view_weight_options {
 // Errors: a non-finite field, a zero forward vector, up parallel to forward, fov outside (0, π)
 // (bad_parameter, each named); a zero-size viewport (bad_size). O(1).
 inline status check_camera(const lod_camera& cam) {
-  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (!finite(cam.position)) return make_error(errc::bad_parameter, no_element, "camera position is not finite");
-  if (!finite(cam.forward) || !finite(cam.up))
+  if (!all_finite(cam.position)) return make_error(errc::bad_parameter, no_element, "camera position is not finite");
+  if (!all_finite(cam.forward) || !all_finite(cam.up))
     return make_error(errc::bad_parameter, no_element, "camera forward or up vector is not finite");
   if (!(glm::length(cam.forward) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera forward vector is zero");
   if (!(glm::length(glm::cross(cam.forward, cam.up)) > 1e-12 * glm::length(cam.forward) * glm::length(cam.up)))
@@ -193,8 +192,7 @@ inline selection_stats select_for_view(const contraction_hierarchy& h, std::span
     st.budgeted = budgets_for_target(h, maxima, k, t, budget);
     (void)stop_points_from_budgets(h, budget, stop);  // budgets never exceed capacities
     match_neighbours(h, stop);
-    st.applied = 0;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) st.applied += applied_count(h, c, stop[c]);
+    st.applied = applied_total(h, stop);
     ++st.rounds;
     return st.applied <= target;
   };

@@ -103,7 +103,7 @@ class view_dependent_lod {
       if (status s = paper_stop_points(camera.position, global_contractions); !s.ok()) return s;
       for (std::uint64_t b : budget_) st.budgeted += b;
       st.matching_sweeps = match_neighbours(*h_, stop_);
-      for (std::uint32_t c = 0; c < h_->cluster_count; ++c) st.applied += applied_count(*h_, c, stop_[c]);
+      st.applied = applied_total(*h_, stop_);
     }
     auto n = contract_indices(*h_, stop_, work_, out, ranges, exec);
     if (!n.ok()) return n.error();

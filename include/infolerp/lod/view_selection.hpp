@@ -50,6 +50,13 @@ inline std::uint32_t applied_count(const contraction_hierarchy& h, std::uint32_t
   return static_cast<std::uint32_t>(std::lower_bound(b, e, s) - b);
 }
 
+// Contractions all clusters apply at their stop points. O(C log capacity).
+inline std::uint64_t applied_total(const contraction_hierarchy& h, std::span<const std::uint32_t> stop) {
+  std::uint64_t n = 0;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) n += applied_count(h, c, stop[c]);
+  return n;
+}
+
 // Neighbour matching in place; returns the sweeps run (>= 1). Preconditions: stop holds one
 // entry per cluster. O(sweeps · applied cross-cluster dependencies), no allocation.
 inline std::uint32_t match_neighbours(const contraction_hierarchy& h, std::span<std::uint32_t> stop) {

@@ -41,8 +41,7 @@ status check_indices_and_positions(const M& m) {
       if (tri[c] >= nv)
         return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", tri[c],
                           " out of range (vertex count ", nv, ")");
-      const glm::vec3 p = mesh_position(m, tri[c]);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      if (!all_finite(mesh_position(m, tri[c])))
         return make_error(errc::non_finite, tri[c], "vertex ", tri[c], " (triangle ", t, "): non-finite position");
     }
   }
@@ -117,8 +116,7 @@ inline result<std::vector<double>> mean_curvature(std::span<const glm::dvec3> po
       if (v >= positions.size())
         return make_error(errc::index_out_of_range, t, "triangle ", t, " corner ", c, ": vertex index ", v,
                           " out of range (vertex count ", positions.size(), ")");
-      const glm::dvec3 p = positions[v];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      if (!all_finite(positions[v]))
         return make_error(errc::non_finite, v, "vertex ", v, " (triangle ", t, "): non-finite position");
     }
   return detail::mean_curvature_kernel(

@@ -53,16 +53,15 @@ status validate_mesh(const M& m, const validate_options& options = {}) {
                           tri[c], " out of range (vertex count ", nv, ")");
   }
 
-  const auto finite = [](const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); };
   if (options.check_unused_vertices) {
     for (std::size_t v = 0; v < nv; ++v)
-      if (!finite(mesh_position(m, v)))
+      if (!all_finite(mesh_position(m, v)))
         return make_error(errc::non_finite, v, "validate_mesh: vertex ", v, ": non-finite position");
   } else {
     for (std::size_t t = 0; t < nt; ++t) {
       const glm::uvec3 tri = mesh_triangle(m, t);
       for (int c = 0; c < 3; ++c)
-        if (!finite(mesh_position(m, tri[c])))
+        if (!all_finite(mesh_position(m, tri[c])))
           return make_error(errc::non_finite, tri[c], "validate_mesh: vertex ", tri[c], " (triangle ", t, " corner ", c,
                             "): non-finite position");
     }

@@ -434,9 +434,8 @@ class progressive_refiner {
                         " pixels, more than max_view_pixels (", max_view_pixels, ")");
     if constexpr (requires { camera.eye; camera.target; camera.up; camera.vertical_fov_degrees; }) {
       const glm::vec3 e = camera.eye, t = camera.target, u = camera.up;
-      for (int k = 0; k < 3; ++k)
-        if (!std::isfinite(e[k]) || !std::isfinite(t[k]) || !std::isfinite(u[k]))
-          return make_error(errc::non_finite, no_element, "camera eye, target or up is not finite");
+      if (!all_finite(e) || !all_finite(t) || !all_finite(u))
+        return make_error(errc::non_finite, no_element, "camera eye, target or up is not finite");
       if (e == t) return make_error(errc::bad_parameter, no_element, "camera eye equals target: no view direction");
       const glm::vec3 f = pinhole_camera::forward(e, t);
       if (f == glm::vec3(0.0f))
@@ -785,10 +784,31 @@ class progressive_refiner {
       if (in_view_[c] == clock_ && !ready(c)) return false;
     return true;
   }
+  // The display walk's outcome at a triangle: the triangle shown so far, and whether the walk
+  // goes on below it.
+  struct display_step {
+    std::uint32_t shown = invalid_id;
+    bool open = true;
+  };
+  // Triangle t's outcome from its parent's (`above`): the walk stops at a triangle not ready;
+  // a ready one is shown and the walk goes on below it when it expands.
+  [[nodiscard]] display_step decide(std::uint32_t t, display_step above) const {
+    if (!above.open) return above;
+    if (!ready(t)) return {above.shown, false};
+    return {t, !mesh_.triangle(t).is_leaf() && expands(t)};
+  }
   [[nodiscard]] bool newly_delivered(std::uint32_t t) const {
     const glm::uvec3 v = mesh_.triangle(t).vertices;
     return delivered_epoch_[v.x] == delta_epoch_ || delivered_epoch_[v.y] == delta_epoch_ ||
            delivered_epoch_[v.z] == delta_epoch_;
+  }
+
+  // A new stamp for decided_ and shown_mark_ (arrays sized by grow()); on wrap-around both restart.
+  void next_display_clock() {
+    if (++display_clock_ != 0) return;
+    std::fill(decided_.begin(), decided_.end(), 0u);
+    std::fill(shown_mark_.begin(), shown_mark_.end(), 0u);
+    display_clock_ = 1;
   }
 
   // The shown set: for each visible leaf, walk down from its root while triangles are ready and
@@ -796,11 +816,7 @@ class progressive_refiner {
   // alone, so each in-view triangle is decided once per call: O(in-view triangles), not
   // O(visible · level).
   void update_display() {
-    const std::size_t nt = mesh_.triangle_count();
-    if (++display_clock_ == 0) decided_.assign(nt, 0), shown_mark_.assign(nt, 0), display_clock_ = 1;
-    decided_.resize(nt, 0);
-    shown_mark_.resize(nt, 0);
-    decision_.resize(nt);
+    next_display_clock();
     previous_shown_.swap(shown_);
     shown_.clear();  // leaves shown themselves, ascending as visible_ is
     shown_above_.clear();  // ancestors shown for their leaves, each once
@@ -810,10 +826,7 @@ class progressive_refiner {
       for (; t != invalid_id && decided_[t] != display_clock_; t = mesh_.triangle(t).parent) path_.push_back(t);
       display_step above = t == invalid_id ? display_step{invalid_id, true} : decision_[t];
       for (auto it = path_.rbegin(); it != path_.rend(); ++it) {
-        if (above.open) {
-          if (!ready(*it)) above.open = false;
-          else above = {*it, *it != leaf && expands(*it)};
-        }
+        above = decide(*it, above);
         decided_[*it] = display_clock_;
         decision_[*it] = above;
       }
@@ -846,11 +859,7 @@ class progressive_refiner {
   // parents first, are all that can change. The shown set follows per-triangle counts of the
   // visible leaves showing it. O(seeded subtrees + shown); the same cut as update_display().
   void begin_display_update() {
-    if (++display_clock_ == 0) {
-      std::fill(decided_.begin(), decided_.end(), 0u);
-      std::fill(shown_mark_.begin(), shown_mark_.end(), 0u);
-      display_clock_ = 1;
-    }
+    next_display_clock();
     seeds_.clear();
     touched_.clear();
   }
@@ -880,14 +889,9 @@ class progressive_refiner {
         stack_.pop_back();
         decided_[t] = display_clock_;
         const subdivision_triangle& n = mesh_.triangle(t);
-        display_step above = n.parent == invalid_id ? display_step{invalid_id, true} : decision_[n.parent];
-        const bool leaf = n.is_leaf();
-        if (above.open) {
-          if (!ready(t)) above.open = false;
-          else above = {t, !leaf && expands(t)};
-        }
+        const display_step above = decide(t, n.parent == invalid_id ? display_step{invalid_id, true} : decision_[n.parent]);
         decision_[t] = above;
-        if (leaf) set_display(t, above.shown);
+        if (n.is_leaf()) set_display(t, above.shown);
         for (std::uint32_t c = n.first_child; c < n.first_child + n.child_count; ++c)
           if (in_view_[c] == clock_) stack_.push_back(c);
       }
@@ -984,12 +988,8 @@ class progressive_refiner {
   std::vector<std::uint32_t> visible_;
   std::vector<std::uint32_t> in_view_;     // per triangle: clock_ when it or a descendant is visible
   std::vector<std::uint32_t> display_of_;  // per visible leaf: the shown triangle over it
-  // update_display()'s per-triangle outcome (shown so far, walk goes on) stamped with
-  // display_clock_, and its mark of triangles already in shown_.
-  struct display_step {
-    std::uint32_t shown = invalid_id;
-    bool open = true;
-  };
+  // The display walk's per-triangle outcome, stamped with display_clock_, and its mark of
+  // triangles already in shown_.
   std::vector<display_step> decision_;
   std::vector<std::uint32_t> decided_, shown_mark_;
   std::uint32_t display_clock_ = 0;

@@ -113,7 +113,7 @@ struct view_importance {
 // wrong size (bad_size). Complexity O(clusters); no allocation unless an error is returned.
 inline status estimate_view_importance(const cluster_table& table, const glm::dvec3& camera_position,
                                        std::span<double> area_estimate, std::span<double> importance_estimate) {
-  if (!std::isfinite(camera_position.x) || !std::isfinite(camera_position.y) || !std::isfinite(camera_position.z))
+  if (!all_finite(camera_position))
     return make_error(errc::bad_parameter, no_element, "camera position is not finite");
   const auto& cs = table.clusters;
   if (area_estimate.size() != cs.size() || importance_estimate.size() != cs.size())
@@ -182,7 +182,7 @@ inline status distribute_contractions(std::span<const double> priority, std::spa
   // A portion at or above 2^64 (global_target near UINT64_MAX) cannot be cast: it is the whole target.
   const double portion = std::ceil(lambda_perc * static_cast<double>(global_target));
   const std::uint64_t step =
-      portion >= 18446744073709551616.0 ? global_target : std::max<std::uint64_t>(1, static_cast<std::uint64_t>(portion));
+      portion >= 0x1p64 ? global_target : std::max<std::uint64_t>(1, static_cast<std::uint64_t>(portion));
   std::fill(out.begin(), out.end(), std::uint64_t{0});
   std::uint64_t remaining = global_target;
   bool progress = true;

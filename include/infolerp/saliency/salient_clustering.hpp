@@ -333,9 +333,8 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
 
 // Salient clustering of a mesh from per-vertex saliency (saliency/mesh_saliency.hpp).
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
-// non-finite (non_finite) or negative (bad_parameter) saliency
-// (names the vertex); clusters == 0 or more clusters than the
-// pool or the triangle count can seed, or more than the mesh has room for (each seed needs a
+// non-finite (non_finite) or negative (bad_parameter) saliency (names the vertex); clusters == 0
+// or more clusters than the pool or the triangle count can seed, or more than the mesh has room for (each seed needs a
 // face no other seed touches); pool_multiplier < 1; normal_weight < 1 (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
@@ -351,7 +350,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     return make_error(errc::bad_size, saliency.size(), "saliency has ", saliency.size(), " values for ", nv, " vertices");
   for (std::size_t v = 0; v < nv; ++v)
     if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
-      return make_error(std::isfinite(saliency[v]) ? errc::bad_parameter : errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
+      return make_error(non_negative_errc(saliency[v]), v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
   if (!(opt.pool_multiplier >= 1.0) || !std::isfinite(opt.pool_multiplier))
     return make_error(errc::bad_parameter, no_element, "pool_multiplier ", opt.pool_multiplier, " must be >= 1");
   if (!(opt.normal_weight >= 1.0) || !std::isfinite(opt.normal_weight))
@@ -437,7 +436,7 @@ status check_cluster_inputs(const M& m, std::span<const double> saliency, std::s
     return make_error(errc::bad_size, cluster.size(), "cluster has ", cluster.size(), " ids for ", nt, " triangles");
   for (std::size_t v = 0; v < nv; ++v)
     if (!(saliency[v] >= 0.0) || !std::isfinite(saliency[v]))
-      return make_error(std::isfinite(saliency[v]) ? errc::bad_parameter : errc::non_finite, v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
+      return make_error(non_negative_errc(saliency[v]), v, "vertex ", v, ": saliency ", saliency[v], " is not finite and >= 0");
   for (std::size_t t = 0; t < nt; ++t)
     if (cluster[t] >= cluster_count)
       return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
@@ -451,9 +450,8 @@ status check_cluster_inputs(const M& m, std::span<const double> saliency, std::s
 // mean over the vertices of cluster c's triangles (each vertex once); the first term is 0 when
 // max S_c = min S_c.
 // Errors: mesh errors as mean_curvature; saliency.size() != V or cluster.size() != T
-// (bad_size); a non-finite (non_finite) or negative (bad_parameter) saliency
-// (names the vertex); a cluster id >=
-// cluster_count (names the triangle). Complexity O(V + T); allocation O(T + V + clusters).
+// (bad_size); a non-finite (non_finite) or negative (bad_parameter) saliency (names the
+// vertex); a cluster id >= cluster_count (names the triangle). Complexity O(V + T); allocation O(T + V + clusters).
 // Serial; pure.
 template <class M>
 result<std::vector<double>> cluster_localized_saliency(const M& m, std::span<const double> saliency,

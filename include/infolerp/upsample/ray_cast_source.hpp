@@ -137,7 +137,7 @@ class ray_cast_source {
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ao_radius must be finite and >= 0");
     if (!(options.ray_offset >= 0.0f) || !std::isfinite(options.ray_offset))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ray_offset must be finite and >= 0");
-    if (!finite3(options.view_origin) || !finite3(options.view_forward))
+    if (!all_finite(options.view_origin) || !all_finite(options.view_forward))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: view_origin and view_forward must be finite");
     for (std::uint32_t g = 0; g < clusters.size(); ++g)
       if (status s = check_attributes(geometry(g), g); !s.ok()) return s;
@@ -182,8 +182,6 @@ class ray_cast_source {
         clusters_(std::move(clusters)), options_(std::move(options)), hemisphere_(cosine_hemisphere(options_.ao_rays)) {}
 
   static float pixel(std::uint32_t i) { return static_cast<float>(i) + 0.5f; }
-  static bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
   // Normals and texcoords that surface() reads: finite, and texcoords of the adaptors whole.
   template <class M>
   static status check_attributes(const M& m, std::uint32_t g) {
@@ -194,13 +192,13 @@ class ray_cast_source {
     if constexpr (mesh_with_normals<M>)
       if (mesh_has_normals(m))
         for (std::size_t v = 0; v < mesh_vertex_count(m); ++v)
-          if (!finite3(mesh_traits<M>::normal(m, v)))
+          if (!all_finite(mesh_traits<M>::normal(m, v)))
             return make_error(errc::non_finite, v, "ray_cast_source: geometry ", g, " vertex ", v, " has a non-finite normal");
     if constexpr (textured_mesh<M>)
       if (mesh_has_texcoords(m))
         for (std::size_t t = 0; t < mesh_triangle_count(m); ++t)
           for (unsigned c = 0; c < 3; ++c)
-            if (const glm::vec2 w = mesh_traits<M>::texcoord(m, t, c); !std::isfinite(w.x) || !std::isfinite(w.y))
+            if (!all_finite(mesh_traits<M>::texcoord(m, t, c)))
               return make_error(errc::non_finite, t, "ray_cast_source: geometry ", g, " triangle ", t, " corner ", c,
                                 " has a non-finite texcoord");
     return {};
