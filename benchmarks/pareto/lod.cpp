@@ -293,11 +293,10 @@ view_distances vertex_distances(const indexed_mesh& m, const std::vector<double>
 std::vector<support::camera> view_cameras(const indexed_mesh& m) {
   std::vector<support::camera> cams;
   for (unsigned k = 0; k < 8; ++k) cams.push_back(support::mesh_view_camera(k, 8, m.positions));
+  const auto close = static_cast<float>(1.2 * 0.5 * mesh_bounds(m).diagonal());
   for (unsigned k = 0; k < 8; ++k) {
     support::camera c = support::mesh_view_camera(2 * k + 1, 16, m.positions);
-    const glm::vec3 dir = glm::normalize(c.eye - c.target);
-    const bounding_box box = mesh_bounds(m);
-    c.eye = c.target + static_cast<float>(1.2 * 0.5 * box.diagonal()) * dir;
+    c.eye = c.target + close * glm::normalize(c.eye - c.target);
     cams.push_back(c);
   }
   return cams;
@@ -378,10 +377,11 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
                        idx.size() / 3, sim->psnr, sim->ssim, d.weighted, d.salient, sec);
         std::fflush(csv);
       }
-      if (v == 7 || v == 15)
+      if (v == 7 || v == 15) {
         std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshoptimizer %.2f dB\n", name.c_str(), f,
-                    v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8),
-            psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0;
+                    v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8);
+        psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0;
+      }
     }
   }
 }

@@ -94,7 +94,7 @@ TEST_CASE("view LOD: random cameras, inside the mesh included, get crack-free LO
   }
 }
 
-TEST_CASE("view LOD: a camera inside the mesh gets the same LOD as the paper option refused", "[lod]") {
+TEST_CASE("view LOD: a camera inside the mesh gets a LOD under either selection", "[lod]") {
   const sphere_lod s;
   for (lod_selection sel : {lod_selection::screen_error, lod_selection::paper}) {
     auto lod = view_dependent_lod::create(s.h, s.table, {.selection = sel, .view = {}});
