@@ -138,7 +138,9 @@ class atrous_filter {
         const std::ptrdiff_t x0 = std::max<std::ptrdiff_t>(0, -off), x1 = std::min(w, w - off);
         if (x0 >= x1) continue;
         const float hk = kernel[static_cast<std::size_t>(dy + 2)] * kernel[static_cast<std::size_t>(dx + 2)];
-        const std::size_t q0 = static_cast<std::size_t>(yy * w + off);  // the tap of pixel x is q0 + x
+        // The tap of pixel x0 + i is q0 + i: pointers start at the first tap inside the row, never
+        // before the buffer (pointer arithmetic past its start is undefined even when unread).
+        const std::size_t q0 = static_cast<std::size_t>(yy * w + off + x0);
         const float* __restrict qnx = g.nx.data() + q0;
         const float* __restrict qny = g.ny.data() + q0;
         const float* __restrict qnz = g.nz.data() + q0;
@@ -147,19 +149,20 @@ class atrous_filter {
         const float* __restrict qa = sa.data() + q0;
         const float* __restrict qb = sb.data() + q0;
 #pragma omp simd
-        for (std::ptrdiff_t x = x0; x < x1; ++x) {
-          float c = pnx[x] * qnx[x] + pny[x] * qny[x] + pnz[x] * qnz[x];
+        for (std::ptrdiff_t i = 0; i < x1 - x0; ++i) {
+          const std::ptrdiff_t x = x0 + i;
+          float c = pnx[x] * qnx[i] + pny[x] * qny[i] + pnz[x] * qnz[i];
           c = 0.5f * (c + std::abs(c));  // max(c, 0) without a compare (one that may trap does not if-convert)
           c *= c, c *= c, c *= c, c *= c, c *= c, c *= c, c *= c;  // ^128
-          const float t = std::abs(pz[x] - qz[x]) * tol[x] * inv_step;
+          const float t = std::abs(pz[x] - qz[i]) * tol[x] * inv_step;
           float wz = 1.0f - 0.25f * t;
           wz = 0.5f * (wz + std::abs(wz));
           wz *= wz, wz *= wz;
-          const float same = static_cast<float>(pid[x] == qid[x]);  // a select, not a branch
+          const float same = static_cast<float>(pid[x] == qid[i]);  // a select, not a branch
           const float wt = hk * c * wz * same;
           ws[x] += wt;
-          oa[x] += wt * qa[x];
-          ob[x] += wt * qb[x];
+          oa[x] += wt * qa[i];
+          ob[x] += wt * qb[i];
         }
       }
     }

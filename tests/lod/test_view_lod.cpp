@@ -76,8 +76,14 @@ TEST_CASE("view LOD: random cameras, inside the mesh included, get crack-free LO
   std::uniform_int_distribution<std::uint64_t> budget(0, lod->capacity());
   for (int k = 0; k < 40; ++k) {
     // Every fourth camera inside the sphere (and inside every cluster's bounding sphere).
-    const glm::dvec3 eye = k % 4 == 0 ? 0.3 * glm::dvec3(unit(rng), unit(rng), unit(rng)) : glm::dvec3(pos(rng), pos(rng), pos(rng));
-    lod_camera cam = look_at(eye, glm::dvec3(unit(rng), unit(rng), unit(rng)));
+    // One draw per statement: the order of a constructor's arguments differs between compilers.
+    const auto draw3 = [&](std::uniform_real_distribution<double>& d) {
+      glm::dvec3 v;
+      for (int a = 0; a < 3; ++a) v[a] = d(rng);
+      return v;
+    };
+    const glm::dvec3 eye = k % 4 == 0 ? 0.3 * draw3(unit) : draw3(pos);
+    lod_camera cam = look_at(eye, draw3(unit));
     if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-3) continue;
     const std::uint64_t r = k == 1 ? lod->capacity() : budget(rng);
     auto st = lod->frame(cam, r, out, ranges);

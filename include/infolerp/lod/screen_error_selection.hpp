@@ -23,7 +23,9 @@
 // bits of a double: 64 steps of O(C log n)), topped up to the target from the next larger τ.
 // Matching only adds contractions and grows with the target, so the target handed to this
 // step is bisected (at most 11 rounds: to 1/1024 of the budget) to a target whose matched sum
-// fits the budget.
+// fits the budget. Where matching cannot fit the view's choice into half the budget (a cluster's
+// first contractions depend on many of the others'), the frame takes the global prefix of the
+// budget's length instead: it applies exactly the budget and needs no matching.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -205,6 +207,11 @@ inline selection_stats select_for_view(const contraction_hierarchy& h, std::span
     (at_lo ? lo : hi) = mid;
   }
   if (!at_lo) run(lo);
+  if (st.applied < target / 2) {  // the global prefix (see the top of the file)
+    std::fill(stop.begin(), stop.end(), static_cast<std::uint32_t>(target));
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = applied_count(h, c, stop[c]);
+    st.budgeted = st.applied = target;
+  }
   return st;
 }
 
