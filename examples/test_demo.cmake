@@ -48,13 +48,17 @@ if(MODE STREQUAL "errors")
   expect_error(2 "--threshold needs CHANNEL=VALUE" --threshold visibility)
   expect_error(2 "--mesh needs a file name" --mesh)
 
-  # Files: missing, not a mesh, truncated, an index out of range, a NaN coordinate.
+  # Files: missing, not a mesh, truncated, counts the file cannot hold, an index out of range, a
+  # NaN coordinate.
   expect_error(1 "cannot open mesh '${WORK_DIR}/missing.off'" --mesh ${WORK_DIR}/missing.off)
   expect_error(1 "cannot load mesh '${WORK_DIR}/missing.obj'" --mesh ${WORK_DIR}/missing.obj)
   file(WRITE ${WORK_DIR}/garbage.off "this is not a mesh\n")
   expect_error(1 "not an OFF file" --mesh ${WORK_DIR}/garbage.off)
-  file(WRITE ${WORK_DIR}/truncated.off "OFF\n4 2 0\n0 0 0\n1 0 0\n")
-  expect_error(1 "line 4: truncated vertex list" --mesh ${WORK_DIR}/truncated.off)
+  file(WRITE ${WORK_DIR}/truncated.off "OFF\n4 2 0\n0 0 0\n1 0 0\n# a comment long enough for the counts\n")
+  expect_error(1 "line 5: truncated vertex list" --mesh ${WORK_DIR}/truncated.off)
+  file(WRITE ${WORK_DIR}/huge.off "OFF\n1000000000000 1 0\n0 0 0\n")
+  expect_error(1 "line 2: the header's counts \\(1000000000000 vertices, 1 faces\\) need more than the file's 28 bytes"
+               --mesh ${WORK_DIR}/huge.off)
   file(WRITE ${WORK_DIR}/index.off "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 2 1 9\n")
   expect_error(1 "triangle 1 corner 2: vertex index 9 out of range \\(vertex count 4\\)" --mesh ${WORK_DIR}/index.off)
   file(WRITE ${WORK_DIR}/nan.off "OFF\n4 2 0\n0 0 0\n1 0 0\nnan 1 0\n1 1 0\n3 0 1 2\n3 2 1 3\n")
