@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <random>
 #include <vector>
 #include <catch2/catch.hpp>
 #include "infolerp/lod/cluster_local_indices.hpp"
@@ -89,7 +91,8 @@ struct lod_setup {
   indexed_mesh mesh;
   std::vector<std::uint32_t> cluster;
   std::uint32_t count = 0;
-  contraction_hierarchy h;
+  std::vector<double> weights;  // the weighting map, for hierarchies of other options
+  contraction_hierarchy h;      // the default hierarchy (one global order)
   cluster_table table;
 };
 
@@ -105,7 +108,8 @@ lod_setup real_mesh(const char* name) {
   s.cluster = clusters->cluster, s.count = clusters->count;
   auto wm = weighting_map(s.mesh, sal->saliency, s.cluster, s.count);
   REQUIRE(wm.ok());
-  auto h = make_contraction_hierarchy(s.mesh, *wm, s.cluster, s.count);
+  s.weights = std::move(*wm);
+  auto h = make_contraction_hierarchy(s.mesh, s.weights, s.cluster, s.count);
   REQUIRE(h.ok());
   s.h = std::move(*h);
   auto table = compute_cluster_attributes(s.mesh, sal->saliency, s.cluster, s.count);
@@ -114,42 +118,111 @@ lod_setup real_mesh(const char* name) {
   return s;
 }
 
-// frame() at the given fractions of the hierarchy's contractions, each converted and checked.
-void check_budgets(const lod_setup& s, const local_index_table& t, const glm::dvec3& camera) {
-  auto lod = view_dependent_lod::create(s.h, s.table);
-  REQUIRE(lod.ok());
-  std::vector<std::uint32_t> in(contracted_index_bound(s.h));
-  std::vector<index_range> ranges(s.h.cluster_count), parts(t.part_count());
+lod_camera look_at(const glm::dvec3& eye, const glm::dvec3& at) { return {eye, at - eye, {0.0, 1.0, 0.0}, 0.8, 512, 512}; }
+
+// Cameras around and inside a box: one far, one close with part of the mesh behind it, one at
+// the centre (inside the mesh and inside the clusters' bounding spheres), then random ones, every
+// third of them inside the box. One draw per statement: argument order differs between compilers.
+std::vector<lod_camera> cameras_for(const bounding_box& box, std::size_t random_count) {
+  const glm::dvec3 c = box.center(), half = 0.5 * (box.hi - box.lo);
+  const double d = box.diagonal();
+  std::vector<lod_camera> cams = {look_at(c + glm::dvec3(0.3, 0.2, 2.0) * d, c),
+                                  look_at(c + glm::dvec3(0.0, 0.1, 0.3) * d, c + glm::dvec3(0.2, 0.0, -1.0) * d),
+                                  look_at(c, c + glm::dvec3(1.0, 0.2, 0.1))};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  while (cams.size() < 3 + random_count) {
+    glm::dvec3 eye, at;
+    for (int a = 0; a < 3; ++a) eye[a] = unit(rng);
+    for (int a = 0; a < 3; ++a) at[a] = unit(rng);
+    eye = cams.size() % 3 == 0 ? c + eye * half : c + 1.5 * d * eye;
+    const lod_camera cam = look_at(eye, c + at * half);
+    if (glm::length(glm::cross(glm::normalize(cam.forward), cam.up)) > 1e-2) cams.push_back(cam);
+  }
+  return cams;
+}
+
+// Converts and checks one frame's output.
+void check_localized(const local_index_table& t, std::span<const std::uint32_t> in, std::span<const index_range> ranges,
+                     std::span<std::uint16_t> out, std::span<index_range> parts) {
+  auto n = localize_indices(t, in, ranges, out, parts);
+  if (!n.ok()) FAIL(n.error().message());
+  check_frame(t, in, ranges, out, parts, *n);
+}
+
+// frame() under both selections (screen_error with its global-prefix fallback, paper) for each
+// camera at several fractions of the hierarchy's contractions, each converted and checked.
+void check_frames(const contraction_hierarchy& h, const cluster_table& table, const local_index_table& t,
+                  std::span<const lod_camera> cams) {
+  std::vector<std::uint32_t> in(contracted_index_bound(h));
+  std::vector<index_range> ranges(h.cluster_count), parts(t.part_count());
   std::vector<std::uint16_t> out(in.size());
-  for (double f : {0.0, 0.3, 0.65, 0.9, 0.99}) {
-    const auto budget = static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity()));
-    auto st = lod->frame(camera, budget, in, ranges);
-    REQUIRE(st.ok());
-    auto n = localize_indices(t, in, ranges, out, parts);
-    if (!n.ok()) FAIL(n.error().message());
-    INFO("budget " << budget << " of " << lod->capacity());
-    check_frame(t, in, ranges, out, parts, *n);
+  std::size_t per_view = 0, prefix = 0;  // screen_error frames whose stop points differ / are one prefix
+  for (lod_selection sel : {lod_selection::screen_error, lod_selection::paper}) {
+    auto lod = view_dependent_lod::create(h, table, {.selection = sel, .view = {}});
+    REQUIRE(lod.ok());
+    for (std::size_t k = 0; k < cams.size(); ++k) {
+      const double f = std::array{0.0, 0.3, 0.65, 0.9, 0.95, 0.99, 1.0}[k % 7];
+      const auto budget = static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity()));
+      auto st = lod->frame(cams[k], budget, in, ranges);
+      if (!st.ok()) FAIL(st.error().message());
+      INFO("selection " << static_cast<int>(sel) << ", camera " << k << ", budget " << budget << " of "
+                        << lod->capacity());
+      check_localized(t, in, ranges, out, parts);
+      const auto stops = lod->stop_points();
+      if (sel == lod_selection::screen_error)
+        ++(std::adjacent_find(stops.begin(), stops.end(), std::not_equal_to<>()) == stops.end() ? prefix : per_view);
+    }
+  }
+  INFO(per_view << " per-view and " << prefix << " single-prefix screen_error frames");
+  CHECK(per_view > 0);
+}
+
+// Any dependency-closed stop points, beyond those a selection makes today: random stop points
+// closed by neighbour matching, and global prefixes (the fallback of the default selection).
+void check_closed_stop_points(const contraction_hierarchy& h, const local_index_table& t, int draws) {
+  contraction_workspace w = make_contraction_workspace(h);
+  std::vector<std::uint32_t> in(contracted_index_bound(h)), stop(h.cluster_count);
+  std::vector<index_range> ranges(h.cluster_count), parts(t.part_count());
+  std::vector<std::uint16_t> out(in.size());
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::uint32_t> at(0, static_cast<std::uint32_t>(h.contraction_count()));
+  for (int k = 0; k < draws; ++k) {
+    if (k % 2 == 0) {
+      for (std::uint32_t& s : stop) s = at(rng);
+      match_neighbours(h, stop);
+    } else {
+      std::fill(stop.begin(), stop.end(), at(rng));
+    }
+    INFO("draw " << k);
+    REQUIRE(contract_indices(h, stop, w, in, ranges).ok());
+    check_localized(t, in, ranges, out, parts);
   }
 }
 
 }  // namespace
 
-TEST_CASE("16-bit local indices map back to frame()'s vertices on bunny00 at several budgets", "[lod][real]") {
+TEST_CASE("16-bit local indices map back to frame()'s vertices on bunny00 for any camera and selection", "[lod][real]") {
   const lod_setup s = real_mesh("bunny00");
-  const bounding_box box = mesh_bounds(s.mesh);
-  const glm::dvec3 camera = box.center() + glm::dvec3(0.3, 0.2, 2.0) * box.diagonal();
-  auto whole = make_local_index_table(s.mesh, s.h);  // every cluster fits: one part each
-  REQUIRE(whole.ok());
-  CHECK(whole->part_count() == s.h.cluster_count);
-  check_table(*whole, s.mesh.vertex_count());
-  check_budgets(s, *whole, camera);
-  // A small limit splits every cluster into many parts: the counting sort and the part choice.
-  auto small = make_local_index_table(s.mesh, s.h, 1500);
-  REQUIRE(small.ok());
-  CHECK(small->part_count() > 3 * s.h.cluster_count);
-  for (std::uint32_t p = 0; p < small->part_count(); ++p) REQUIRE(small->vertex_count(p) <= 1500);
-  check_table(*small, s.mesh.vertex_count());
-  check_budgets(s, *small, camera);
+  const std::vector<lod_camera> cams = cameras_for(mesh_bounds(s.mesh), 11);
+  auto local = make_contraction_hierarchy(s.mesh, s.weights, s.cluster, s.count, {.cluster_local_first = true});
+  REQUIRE(local.ok());
+  for (const contraction_hierarchy* h : std::array<const contraction_hierarchy*, 2>{&s.h, &*local}) {
+    INFO((h == &s.h ? "one global order" : "cluster-local phase first"));
+    auto whole = make_local_index_table(s.mesh, *h);  // every cluster fits: one part each
+    REQUIRE(whole.ok());
+    CHECK(whole->part_count() == h->cluster_count);
+    check_table(*whole, s.mesh.vertex_count());
+    check_frames(*h, s.table, *whole, cams);
+    // A small limit splits every cluster into many parts: the counting sort and the part choice.
+    auto small = make_local_index_table(s.mesh, *h, 1500);
+    REQUIRE(small.ok());
+    CHECK(small->part_count() > 3 * h->cluster_count);
+    for (std::uint32_t p = 0; p < small->part_count(); ++p) REQUIRE(small->vertex_count(p) <= 1500);
+    check_table(*small, s.mesh.vertex_count());
+    check_frames(*h, s.table, *small, cams);
+    check_closed_stop_points(*h, *small, 8);
+  }
 }
 
 TEST_CASE("16-bit local indices: a cluster of more than 65,536 vertices is split", "[lod]") {
@@ -171,7 +244,7 @@ TEST_CASE("16-bit local indices: a cluster of more than 65,536 vertices is split
   CHECK(t->part_offsets[1] - t->part_offsets[0] >= 2);
   CHECK(t->part_offsets[2] - t->part_offsets[1] == 1);
   check_table(*t, s.mesh.vertex_count());
-  check_budgets(s, *t, glm::dvec3(0.2, -0.3, 3.0));
+  check_frames(s.h, s.table, *t, cameras_for(mesh_bounds(s.mesh), 3));
 }
 
 TEST_CASE("16-bit local indices: bad input gets a clear status", "[lod]") {
@@ -194,7 +267,7 @@ TEST_CASE("16-bit local indices: bad input gets a clear status", "[lod]") {
   std::vector<std::uint32_t> in(contracted_index_bound(*h));
   std::vector<index_range> ranges(2), parts(t->part_count());
   std::vector<std::uint16_t> out(in.size());
-  REQUIRE(lod->frame(glm::dvec3(0.0, 0.5, 4.0), lod->capacity() / 2, in, ranges).ok());
+  REQUIRE(lod->frame(look_at({0.0, 0.5, 4.0}, {0.0, 0.0, 0.0}), lod->capacity() / 2, in, ranges).ok());
   REQUIRE(localize_indices(*t, in, ranges, out, parts).ok());
 
   std::vector<index_range> one_range(1), few_parts(1);

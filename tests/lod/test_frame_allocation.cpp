@@ -54,7 +54,8 @@ TEST_CASE("16-bit local indices allocate nothing per frame", "[lod]") {
   std::vector<std::uint32_t> out(contracted_index_bound(*h));
   std::vector<std::uint16_t> out16(out.size());
   std::vector<index_range> ranges(3), parts(local->part_count());
-  REQUIRE(lod->frame(glm::dvec3(0.2, 3.0, 1.0), lod->capacity() / 2, out, ranges).ok());
+  const lod_camera camera{{0.2, 3.0, 1.0}, {-0.2, -3.0, -1.0}, {0.0, 0.0, 1.0}, 0.8, 640, 480};
+  REQUIRE(lod->frame(camera, lod->capacity() / 2, out, ranges).ok());
   const std::size_t before = support::heap_allocations.load();
   auto n = localize_indices(*local, out, ranges, out16, parts);
   const std::size_t during = support::heap_allocations.load() - before;

@@ -9,6 +9,10 @@
 // to (the chain removed → target of vertex_contraction.hpp, which may leave the cluster). They
 // are listed ascending by global id; a part's local index is the position in that list. A part
 // whose closure exceeds the limit makes its cluster split again with a smaller limit.
+// The closure does not depend on which contractions a frame applies: a corner's output vertex is
+// always on its chain (it follows the chain up to the first contraction not applied). So one table
+// serves every selection of view_dependent_lod (per-view stop points, the global-prefix fallback,
+// the paper's eqs. 5–9) and any stop points handed to contract_indices.
 //
 // Per frame (localize_indices): the 32-bit buffer and per-cluster ranges of
 // view_dependent_lod::frame() / contract_indices become 16-bit local indices with one range per

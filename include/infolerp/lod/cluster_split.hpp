@@ -4,9 +4,11 @@
 // be easily enforced during pre-processing").
 // Each cluster's triangles are visited along a Morton curve of their centroids and cut into
 // consecutive parts whenever the next triangle would bring the part above max_vertices distinct
-// vertices (one limit for all clusters, or one per cluster), so every part is spatially compact and
-// at most its limit large. A cluster within its limit keeps one id. New ids: the parts of cluster 0 first, then those of cluster 1,
-// and so on (an empty cluster gets none); first_part[c] is the first id of cluster c. Deterministic.
+// vertices (one limit for all clusters, or one per cluster: cluster_local_indices.hpp cuts again
+// only the clusters whose parts overflow), so every part is spatially compact and at most its
+// limit large. A cluster within its limit keeps one id. New ids: the parts of cluster 0 first,
+// then those of cluster 1, and so on (an empty cluster gets none); first_part[c] is the first id
+// of cluster c. Deterministic.
 #include <cstddef>
 #include <cstdint>
 #include <span>
