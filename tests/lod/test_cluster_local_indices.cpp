@@ -247,6 +247,27 @@ TEST_CASE("16-bit local indices: a cluster of more than 65,536 vertices is split
   check_frames(s.h, s.table, *t, cameras_for(mesh_bounds(s.mesh), 3));
 }
 
+TEST_CASE("16-bit local indices: cameras inside a closed mesh and around it", "[lod]") {
+  const indexed_mesh m = support::make_icosphere(4);
+  std::vector<std::uint32_t> cl(m.triangle_count());
+  for (std::size_t t = 0; t < cl.size(); ++t) {  // octants
+    const glm::vec3 x = m.positions[m.triangles[t].x];
+    cl[t] = (x.x > 0.0f ? 1u : 0u) | (x.y > 0.0f ? 2u : 0u) | (x.z > 0.0f ? 4u : 0u);
+  }
+  std::vector<double> sal(m.vertex_count()), w(3 * m.triangle_count(), 1.0);
+  for (std::size_t v = 0; v < sal.size(); ++v) sal[v] = 1.0 + 0.5 * std::sin(3.0 * m.positions[v].x);
+  auto h = make_contraction_hierarchy(m, w, cl, 8);
+  REQUIRE(h.ok());
+  auto table = compute_cluster_attributes(m, sal, cl, 8);
+  REQUIRE(table.ok());
+  auto t = make_local_index_table(m, *h, 200);  // several parts per cluster
+  REQUIRE(t.ok());
+  CHECK(t->part_count() > 2 * 8);
+  // cameras_for's third camera sits at the box's centre, the unit sphere's: inside the mesh and
+  // inside every cluster's bounding sphere; some of its random cameras are inside the mesh too.
+  check_frames(*h, *table, *t, cameras_for(mesh_bounds(m), 12));
+}
+
 TEST_CASE("16-bit local indices: bad input gets a clear status", "[lod]") {
   const indexed_mesh m = support::make_icosphere(3);
   std::vector<std::uint32_t> cl(m.triangle_count());
