@@ -80,11 +80,17 @@ void check_table(const local_index_table& t, std::size_t vertex_count) {
     holders += t.vertex_count(p);
   }
   CHECK(holders == t.holder_part.size());
-  bool ok = true;
-  for (std::uint32_t v = 0; v < vertex_count; ++v)
+  bool ok = true, first_ok = t.first_holder.size() == vertex_count;
+  for (std::uint32_t v = 0; v < vertex_count; ++v) {
     for (std::uint32_t a = t.holder_offsets[v]; a < t.holder_offsets[v + 1]; ++a)
       ok = ok && t.vertices[t.vertex_offsets[t.holder_part[a]] + t.holder_local[a]] == v;
+    const bool held = t.holder_offsets[v] < t.holder_offsets[v + 1];
+    first_ok = first_ok && (held ? t.first_holder[v].part == t.holder_part[t.holder_offsets[v]] &&
+                                       t.first_holder[v].local == t.holder_local[t.holder_offsets[v]]
+                                 : t.first_holder[v].part == invalid_id);
+  }
   CHECK(ok);
+  CHECK(first_ok);
 }
 
 struct lod_setup {

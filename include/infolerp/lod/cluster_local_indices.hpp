@@ -18,7 +18,9 @@
 // view_dependent_lod::frame() / contract_indices become 16-bit local indices with one range per
 // part. A cluster of one part keeps its triangle order; a cluster of several parts is
 // counting-sorted by part, each triangle going to the first part that holds its three corners
-// (the part its original triangle came from always does). Allocation-free.
+// (the part its original triangle came from always does). Most triangles find it in one read
+// per corner (each vertex's first holder); the others merge the corners' holder lists.
+// Allocation-free.
 //
 // What an engine binds for part p: the vertex attributes of vertices[vertex_offsets[p] ..
 // vertex_offsets[p + 1]) (gathered once into one buffer: base vertex = vertex_offsets[p]; or
@@ -46,6 +48,13 @@ struct local_index_table {
   // Per global vertex (CSR): the parts holding it, ascending, and its local index in each.
   std::vector<std::uint32_t> holder_offsets, holder_part;
   std::vector<std::uint16_t> holder_local;
+  // Per global vertex: its first holder (lowest part, invalid_id if none) and its local index
+  // there, one read instead of three for the common case of a triangle whose corners share it.
+  struct holder {
+    std::uint32_t part;
+    std::uint16_t local;
+  };
+  std::vector<holder> first_holder;
 
   [[nodiscard]] std::uint32_t part_count() const { return static_cast<std::uint32_t>(part_cluster.size()); }
   [[nodiscard]] std::uint32_t vertex_count(std::uint32_t part) const {
@@ -158,6 +167,10 @@ result<local_index_table> make_local_index_table(const M& m, const contraction_h
     t.holder_part[a] = p;
     t.holder_local[a] = static_cast<std::uint16_t>(i - t.vertex_offsets[p]);
   }
+  t.first_holder.assign(h.vertex_count, {invalid_id, 0});
+  for (std::uint32_t v = 0; v < h.vertex_count; ++v)
+    if (const std::uint32_t a = t.holder_offsets[v]; a < t.holder_offsets[v + 1])
+      t.first_holder[v] = {t.holder_part[a], t.holder_local[a]};
   return t;
 }
 
@@ -200,8 +213,8 @@ inline bool common_part(const local_index_table& t, const std::uint32_t (&v)[3],
 // the ranges cover (bad_size); a range outside in or not a multiple of 3 (bad_index_count, names
 // the cluster); an index that its cluster's parts do not hold, i.e. input not from this table's
 // hierarchy (index_out_of_range, names the position in in). On error out and part_ranges are
-// partly written. Complexity O(indices · log h) where h is the longest holder list (typically
-// 1–3); no allocation.
+// partly written. Complexity O(indices) where corners share their first holder, O(indices · h)
+// otherwise, h the longest holder list (typically 1–3); no allocation.
 inline result<std::size_t> localize_indices(const local_index_table& t, std::span<const std::uint32_t> in,
                                             std::span<const index_range> ranges, std::span<std::uint16_t> out,
                                             std::span<index_range> part_ranges) {
@@ -235,8 +248,15 @@ inline result<std::size_t> localize_indices(const local_index_table& t, std::spa
       for (std::size_t k = b; k < e; k += 3) {
         std::uint32_t v[3] = {in[k], in[k + 1], in[k + 2]}, part = 0;
         std::uint16_t local[3];
-        if (v[0] >= nv || v[1] >= nv || v[2] >= nv || !detail::common_part(t, v, p0, p1, part, local))
+        if (v[0] >= nv || v[1] >= nv || v[2] >= nv) return missing(k, c);
+        // The corners' first holders agree and lie in this cluster: that part is the first
+        // common one (no lower part holds any corner); otherwise merge the holder lists.
+        const local_index_table::holder h0 = t.first_holder[v[0]], h1 = t.first_holder[v[1]], h2 = t.first_holder[v[2]];
+        if (h0.part == h1.part && h0.part == h2.part && h0.part - p0 < p1 - p0) {
+          part = h0.part, local[0] = h0.local, local[1] = h1.local, local[2] = h2.local;
+        } else if (!detail::common_part(t, v, p0, p1, part, local)) {
           return missing(k, c);
+        }
         index_range& r = part_ranges[part];
         if (pass == 0) {
           r.count += 3;
