@@ -1,8 +1,8 @@
-// Cluster-local 16-bit indices (lod/cluster_local_indices.hpp) on CGAL's meshes (and
-// refined_elephant_x4: refined_elephant subdivided once 1:4, whose larger clusters pass 65,536
-// vertices and are split), the hierarchy
-// and selection view_dependent_lod serves by default (10 salient clusters, one global order,
-// backstop 0.005 as infolerp_pareto lod), camera 2 diagonals from the box centre on +z.
+// Cluster-local 16-bit indices (lod/cluster_local_indices.hpp) on CGAL's meshes and on
+// refined_elephant_x4 (refined_elephant subdivided once 1:4, whose largest cluster passes 65,536
+// vertices and is split), with the hierarchy and selection view_dependent_lod serves by default
+// (10 salient clusters, one global order, backstop 0.005 as infolerp_pareto lod), camera 2
+// diagonals from the box centre on +z.
 //
 // BM_LocalIndices_Frame/<mesh>: per frame at 5% of the triangles (the global prefix's
 // contraction count for that fraction), localize_indices of frame()'s output against a memcpy
