@@ -24,7 +24,8 @@
 //
 // What an engine binds for part p: the vertex attributes of vertices[vertex_offsets[p] ..
 // vertex_offsets[p + 1]) (gathered once into one buffer: base vertex = vertex_offsets[p]; or
-// into one buffer per part), and the 16-bit indices [ranges[p].first, + ranges[p].count).
+// into one buffer per part), and the 16-bit indices [part_ranges[p].first,
+// + part_ranges[p].count).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
