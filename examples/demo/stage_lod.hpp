@@ -16,9 +16,11 @@
 //     PSNR and SSIM against the full mesh's image of the same view (not the scene reference);
 //   - DIR/lod_orbit.png: six cameras around the mesh (mesh_views' circle of 6), each one's
 //     frame() at 5% with the default options; top row the triangles from that camera, bottom row
-//     the same triangles from above with the camera's side marked in red. Both rows are
-//     headlight-shaded with the edges of the drawn triangles overlaid (where neighbouring pixels
-//     see different triangles), so the dense part visibly follows the camera.
+//     the same triangles from the opposite camera. Both rows are headlight-shaded with the edges
+//     of the drawn triangles overlaid (where neighbouring pixels see different triangles), so a
+//     cut that follows the camera shows dense above and coarse below; labels and the printed
+//     lines give each camera's triangle count and the share of them facing it (against the
+//     full mesh's share).
 //
 //   bool stage_lod(demo_context& ctx);
 // Returns false (one line on stderr) when a step fails.
@@ -131,20 +133,11 @@ inline support::image lod_grid(const std::vector<const support::image*>& cells, 
   return out;
 }
 
-// The camera looking straight down (−Z) at the centre of the positions' box, from as far as
-// mesh_views' cameras (the bounding sphere fills the 40° field of view).
-inline support::camera overhead_camera(std::span<const glm::vec3> positions) {
-  glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
-  for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  const glm::vec3 centre = 0.5f * (lo + hi);
-  const float dist = 0.5f * glm::length(hi - lo) / std::sin(20.0f * std::numbers::pi_v<float> / 180.0f);
-  return {centre + glm::vec3(0.0f, 0.0f, dist), centre, {0.0f, 1.0f, 0.0f}, 40.0f};
-}
-
-// The triangles of `scene` seen from c on a side × side image: grey shaded by a headlight
-// (0.35 + 0.65·|n·d|, as render_false_colour), sky black, and the edges of the drawn
-// triangles (pixels whose right or lower neighbour sees another triangle) in dark blue.
-inline support::image wireframe_view(const demo_context& ctx, const support::embree_scene& scene, const indexed_mesh& m,
+// The triangles `tris` (the geometry of `scene`) seen from c on a side × side image: grey
+// shaded by a headlight (0.35 + 0.65·|n·d|, as render_false_colour), sky black, and the edges of
+// the drawn triangles (pixels whose right or lower neighbour sees another triangle) in dark blue.
+inline support::image wireframe_view([[maybe_unused]] const demo_context& ctx, const support::embree_scene& scene,
+                                     std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
                                      const support::camera& c, int side) {
   const auto n = static_cast<std::size_t>(side);
   std::vector<std::uint32_t> id(n * n, invalid_id);
@@ -157,8 +150,8 @@ inline support::image wireframe_view(const demo_context& ctx, const support::emb
       const ray r = rays(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, side, side);
       const hit h = scene.intersect(r);
       if (!h.valid()) continue;
-      const glm::uvec3 t = m.triangles[h.triangle];
-      const glm::vec3 nrm = glm::normalize(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+      const glm::uvec3 t = tris[h.triangle];
+      const glm::vec3 nrm = glm::normalize(glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]));
       img.at(x, y) = glm::vec3(0.8f * (0.35f + 0.65f * std::abs(glm::dot(nrm, r.direction))));
       id[img.index(x, y)] = h.triangle;
     }
@@ -166,55 +159,57 @@ inline support::image wireframe_view(const demo_context& ctx, const support::emb
   for (int y = 0; y < side; ++y)
     for (int x = 0; x < side; ++x) {
       const std::size_t p = img.index(x, y);
-      if ((x + 1 < side && id[p + 1] != id[p]) || (y + 1 < side && id[p + n] != id[p])) img.pixels[p] = {0.02f, 0.06f, 0.35f};
+      if ((x + 1 < side && id[p + 1] != id[p]) || (y + 1 < side && id[p + n] != id[p]))
+        img.pixels[p] = {0.02f, 0.06f, 0.35f};
     }
   return img;
 }
 
-// A red square on the overhead image c_top at the border in the direction of eye's side.
-inline void mark_eye(support::image& img, const support::camera& c_top, const glm::vec3& eye) {
-  const support::pinhole_rays basis = c_top.rays();
-  const glm::vec3 d = eye - c_top.target;
-  const glm::vec2 dir(glm::dot(d, basis.right), -glm::dot(d, basis.true_up));
-  if (!(glm::length(dir) > 0.0f)) return;
-  const glm::vec2 at = 0.5f * glm::vec2(img.width, img.height) * (glm::vec2(1.0f) + 0.88f * glm::normalize(dir));
-  const int r = std::max(2, img.width / 48);
-  detail::fill_rect(img, static_cast<int>(at.x) - r, static_cast<int>(at.y) - r, static_cast<int>(at.x) + r,
-                    static_cast<int>(at.y) + r, [](glm::vec3) { return glm::vec3(1.0f, 0.05f, 0.05f); });
+// The share of the triangles that face the eye (their normal toward it, counter-clockwise).
+inline double facing_share(const indexed_mesh& m, std::span<const glm::uvec3> tris, const glm::vec3& eye) {
+  std::size_t facing = 0;
+  for (const glm::uvec3& t : tris) {
+    const glm::vec3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+    facing += glm::dot(glm::cross(b - a, c - a), eye - a) > 0.0f ? 1 : 0;
+  }
+  return tris.empty() ? 0.0 : static_cast<double>(facing) / static_cast<double>(tris.size());
 }
 
 // DIR/lod_orbit.png: frame() at 5% from six cameras around the mesh (see the prologue).
 inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, view_dependent_lod& lod,
                       const contraction_hierarchy& h, const indexed_mesh& m, int side) {
   constexpr unsigned cameras = 6;
-  const support::camera top = overhead_camera(m.positions);
+  const auto t0 = std::chrono::steady_clock::now();
   std::vector<support::image> images(2 * cameras);
-  std::printf("lod_orbit: infolerp 5%% from %u cameras around the mesh:", cameras);
+  std::printf("lod_orbit: infolerp 5%% from %u cameras around the mesh\n", cameras);
   for (unsigned k = 0; k < cameras; ++k) {
     const support::camera c = support::mesh_view_camera(k, cameras, m.positions);
+    const support::camera behind = support::mesh_view_camera((k + cameras / 2) % cameras, cameras, m.positions);
     lod_panel p{"infolerp", 0.05, {}, 0.0, {}, {}};
     if (auto s = lod_frame(lod, h, lod_eye(c, side), m.triangle_count(), p); !s) return report(s), false;
     std::vector<glm::uvec3> tris(p.indices.size() / 3);
     for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = {p.indices[3 * t], p.indices[3 * t + 1], p.indices[3 * t + 2]};
-    const indexed_mesh drawn{m.positions, tris, {}, {}, {}};
     support::embree_scene scene(device);
-    if (auto id = scene.add_triangles(drawn.positions, drawn.triangles); !id) return report(id.error()), false;
+    if (auto id = scene.add_triangles(m.positions, tris); !id) return report(id.error()), false;
     if (auto s = scene.commit(); !s) return report(s), false;
-    images[k] = wireframe_view(ctx, scene, drawn, c, side);
-    images[cameras + k] = wireframe_view(ctx, scene, drawn, top, side);
-    char text[160];
-    std::snprintf(text, sizeof text, "camera %u: azimuth %u deg, %s\ninfolerp 5%%: %zu triangles", k, 360 * k / cameras,
-                  k % 2 == 0 ? "above" : "below", tris.size());
+    images[k] = wireframe_view(ctx, scene, m.positions, tris, c, side);
+    images[cameras + k] = wireframe_view(ctx, scene, m.positions, tris, behind, side);
+    const double facing = facing_share(m, tris, c.eye), facing_full = facing_share(m, m.triangles, c.eye);
+    char text[200];
+    std::snprintf(text, sizeof text, "camera %u: azimuth %u deg, %s\ninfolerp 5%%: %zu triangles\n%.0f%% face it (full mesh %.0f%%)",
+                  k, 360 * k / cameras, k % 2 == 0 ? "above" : "below", tris.size(), 100.0 * facing, 100.0 * facing_full);
     draw_label(images[k], 0, 0, text, label_scale(side));
-    std::snprintf(text, sizeof text, "camera %u's triangles from above\nred: its side", k);
+    std::snprintf(text, sizeof text, "camera %u's triangles\nfrom the opposite side", k);
     draw_label(images[cameras + k], 0, 0, text, label_scale(side));
-    mark_eye(images[cameras + k], top, c.eye);
-    std::printf(" %zu", tris.size());
+    std::printf("  camera %u: %zu triangles, %.0f%% facing it (full mesh: %.0f%%)\n", k, tris.size(), 100.0 * facing,
+                100.0 * facing_full);
   }
-  std::printf(" triangles\n");
   std::vector<const support::image*> cells;
   for (const auto& img : images) cells.push_back(&img);
-  return save_png(ctx, lod_grid(cells, cameras, side), "lod_orbit.png");
+  const support::image grid = lod_grid(cells, cameras, side);
+  std::printf("lod_orbit: %.3f s for the %u frames and %u images\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), cameras, 2 * cameras);
+  return save_png(ctx, grid, "lod_orbit.png");
 }
 
 }  // namespace detail
