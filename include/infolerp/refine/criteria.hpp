@@ -216,16 +216,18 @@ inline void select_rnd(const refinement_frame& f, const criteria_options& o, cri
   }
 }
 
-// Runs the configured criterion. Returns the number of ids appended (0: nothing qualifies).
-// Complexity and allocation: those of select_nld_os / select_nld_is / select_rnd. Serial;
-// not thread-safe for the same criterion_state (RND advances its random sequence).
-inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
-                                         std::vector<std::uint32_t>& out) {
+// Runs the configured criterion, NLD_OS through nld_os(out, limit) (select_nld_os or a selection
+// kept between batches that returns the same, refine/nld_os_queue.hpp). Returns the number of
+// ids appended (0: nothing qualifies). Complexity and allocation: those of the selection used.
+// Serial; not thread-safe for the same criterion_state (RND advances its random sequence).
+template <class NldOs>
+std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
+                                  std::vector<std::uint32_t>& out, NldOs&& nld_os) {
   const std::size_t before = out.size();
   switch (o.criterion) {
     case refinement_criterion::nld_os: {
       const auto random = static_cast<std::size_t>(std::lround(double(o.random_share) * double(o.batch)));
-      select_nld_os(f, o, out, o.batch - random);
+      nld_os(out, o.batch - random);
       if (random > 0 && !st.exhausted) select_rnd(f, o, st, out, before, o.batch - (out.size() - before));
       break;
     }
@@ -233,6 +235,10 @@ inline std::size_t select_for_refinement(const refinement_frame& f, const criter
     case refinement_criterion::rnd: select_rnd(f, o, st, out, before, o.batch); break;
   }
   return out.size() - before;
+}
+inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
+                                         std::vector<std::uint32_t>& out) {
+  return select_for_refinement(f, o, st, out, [&](std::vector<std::uint32_t>& ids, std::size_t limit) { select_nld_os(f, o, ids, limit); });
 }
 
 }  // namespace infolerp

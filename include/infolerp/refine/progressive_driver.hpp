@@ -54,6 +54,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
+#include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 
 namespace infolerp {
@@ -175,6 +176,7 @@ class progressive_refiner {
     r.mesh_ = std::move(mesh);
     r.options_ = options;
     r.state_.rng = splitmix64{options.criteria.seed};
+    r.index_green_splits();
     return r;
   }
 
@@ -493,6 +495,7 @@ class progressive_refiner {
 
   void reset() {
     mesh_ = initial_mesh_;
+    index_green_splits();
     selected_.clear();
     state_ = criterion_state{};
     state_.rng = splitmix64{options_.criteria.seed};
@@ -580,7 +583,11 @@ class progressive_refiner {
       if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
       luminance_image(exec);  // also L_max
       selected_.clear();
-      select_for_refinement(frame(), options_.criteria, state_, selected_);
+      const refinement_frame f = frame();
+      select_for_refinement(f, options_.criteria, state_, selected_, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
+        nld_os_.select(f, options_.criteria, ids, limit);
+      });
+      const auto first_new = static_cast<std::uint32_t>(mesh_.triangle_count());
       if (selected_.empty()) {
         finished_ = true;
         report_.stage2 = figures();
@@ -592,7 +599,7 @@ class progressive_refiner {
       }
       ++report_.batches;
       report_.selections += selected_.size();
-      follow_splits();
+      follow_splits(first_new);
       render(exec);
       report_.stage2 = figures();
     }
@@ -638,6 +645,7 @@ class progressive_refiner {
     const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
     leaf_pixels_.resize(nt, 0);
     leaf_head_.resize(nt, invalid_id);
+    green_first_.resize(nt, invalid_id);
     in_view_.resize(nt, 0);
     display_of_.resize(nt, invalid_id);
     dirty_mark_.resize(nt, 0);
@@ -684,6 +692,9 @@ class progressive_refiner {
       if (pixel_leaf_[p] != invalid_id) add_pixel(static_cast<std::uint32_t>(p), pixel_leaf_[p]);
     std::sort(fresh_.begin(), fresh_.end());
     visible_.swap(fresh_);
+    nld_os_.clear();
+    if (options_.criteria.criterion == refinement_criterion::nld_os)
+      for (std::uint32_t t : visible_) nld_os_.add(t);
     ++clock_;
     in_view_vertices_ = 0;
     all_dirty_ = true;
@@ -693,16 +704,44 @@ class progressive_refiner {
     update_display();
   }
 
+  // The first children of every 1:2 split (their parent's 1:4 resplit retires both).
+  void index_green_splits() {
+    green_first_.assign(mesh_.triangle_count(), invalid_id);
+    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
+      if (mesh_.triangle(t).child_count == 2) green_first_[t] = mesh_.triangle(t).first_child;
+  }
+
+  // The visible leaves a batch's splits took out of the leaf set, found from the triangles it
+  // created (ids from first_new on): a split leaf is the parent of new children, a retired 1:2
+  // child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
+  void find_split_leaves(std::uint32_t first_new) {
+    split_.clear();
+    for (std::uint32_t c = first_new; c < mesh_.triangle_count(); ++c) {
+      const std::uint32_t p = mesh_.triangle(c).parent;
+      const subdivision_triangle& n = mesh_.triangle(p);
+      if (n.first_child != c) continue;  // one visit per split (a 1:2 split resplit in this batch has another first child)
+      if (leaf_pixels_[p] > 0) split_.push_back(p);
+      if (n.child_count == 4 && green_first_[p] != invalid_id) {
+        for (std::uint32_t g = green_first_[p]; g < green_first_[p] + 2; ++g)
+          if (leaf_pixels_[g] > 0) split_.push_back(g);
+        green_first_[p] = invalid_id;
+      }
+      if (n.child_count == 2) green_first_[p] = c;
+    }
+    std::sort(split_.begin(), split_.end());
+  }
+
   // After a batch's splits: only the pixels of the visible leaves that were split follow them
   // down (pixel lists), the visible set loses those leaves and gains the children that cover
   // pixels, and only the new leaves are walked up for the in-view marks and requests (the
-  // in-view set of a view only grows). O(visible + pixels of the split leaves · level).
-  void follow_splits() {
+  // in-view set of a view only grows). O(new triangles · log + pixels of the split leaves · level)
+  // plus a sequential O(visible) merge of the sorted visible set.
+  void follow_splits(std::uint32_t first_new) {
     grow();
+    find_split_leaves(first_new);
     fresh_.clear();
     begin_display_update();
-    for (std::uint32_t t : visible_) {
-      if (mesh_.is_leaf(t)) continue;
+    for (std::uint32_t t : split_) {
       set_display(t, invalid_id);  // no longer a visible leaf
       seeds_.push_back(mesh_.triangle(t).parent != invalid_id ? mesh_.triangle(t).parent : t);
       std::uint32_t p = leaf_head_[t];
@@ -720,11 +759,12 @@ class progressive_refiner {
     if (fresh_.empty()) return finish_display_update();
     std::sort(fresh_.begin(), fresh_.end());
     for (std::uint32_t t : fresh_) mark_dirty(t);
-    visible_.erase(std::remove_if(visible_.begin(), visible_.end(), [&](std::uint32_t t) { return leaf_pixels_[t] == 0; }),
-                   visible_.end());
-    const auto middle = static_cast<std::ptrdiff_t>(visible_.size());
-    visible_.insert(visible_.end(), fresh_.begin(), fresh_.end());
-    std::inplace_merge(visible_.begin(), visible_.begin() + middle, visible_.end());
+    if (options_.criteria.criterion == refinement_criterion::nld_os)
+      for (std::uint32_t t : fresh_) nld_os_.add(t);
+    scratch_.clear();
+    std::set_difference(visible_.begin(), visible_.end(), split_.begin(), split_.end(), std::back_inserter(scratch_));
+    visible_.resize(scratch_.size() + fresh_.size());
+    std::merge(scratch_.begin(), scratch_.end(), fresh_.begin(), fresh_.end(), visible_.begin());
     stamp_in_view(fresh_);
     enforce_cache_bound();
     finish_display_update();
@@ -996,6 +1036,9 @@ class progressive_refiner {
   std::vector<std::uint32_t> leaf_head_;   // per triangle: first pixel of its list (visible leaves), else invalid_id
   std::vector<std::uint32_t> pixel_next_;  // per pixel: the next pixel of its leaf's list
   std::vector<std::uint32_t> fresh_;       // leaves that gained their first pixel
+  std::vector<std::uint32_t> split_, scratch_;  // a batch's split visible leaves; the visible set being merged
+  std::vector<std::uint32_t> green_first_;  // per triangle split 1:2: its first child, else invalid_id
+  nld_os_queue nld_os_;                     // NLD_OS's candidates in the current view
   std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
