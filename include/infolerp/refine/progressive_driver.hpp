@@ -1042,7 +1042,8 @@ class progressive_refiner {
   // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
   // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
   // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
-  // 1, pixel p at n + p). O(pixels) per view, O(dirty pixels · log pixels) per batch.
+  // 1, pixel p at n + p). O(pixels) per view; per batch O(dirty pixels · log) for their sort and
+  // the tree nodes whose maximum changed.
   template <class E>
   void luminance_image(E&& exec) {
     const std::size_t n = pixel_leaf_.size();
@@ -1055,17 +1056,38 @@ class progressive_refiner {
       for (std::size_t i = n; i-- > 1;) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
       all_dirty_ = false;
     } else {
+      tree_level_.clear();  // parents of the pixels whose value changed
       for (std::uint32_t leaf : dirty_)
         for (std::uint32_t p = leaf_head_[leaf]; p != invalid_id; p = pixel_next_[p]) {
-          pixel_luminance_[p] = luminance(pixel_colour(p));
-          std::size_t i = n + p;
-          lum_tree_[i] = pixel_luminance_[p];
-          for (i /= 2; i >= 1; i /= 2) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+          const float l = pixel_luminance_[p] = luminance(pixel_colour(p));
+          if (lum_tree_[n + p] == l) continue;
+          lum_tree_[n + p] = l;
+          tree_level_.push_back(static_cast<std::uint32_t>((n + p) / 2));
         }
+      update_lum_tree();
     }
     dirty_.clear();
     if (++dirty_clock_ == 0) std::fill(dirty_mark_.begin(), dirty_mark_.end(), 0u), dirty_clock_ = 1;
     l_max_ = n == 0 ? 0.0f : std::max(0.0f, lum_tree_[1]);
+  }
+
+  // The max-tree's nodes above changed pixels, one level at a time: a node is recomputed once
+  // (its changed children share it) and its parent only when its own value changed.
+  // O(changed nodes + sort of the changed pixels).
+  void update_lum_tree() {
+    std::sort(tree_level_.begin(), tree_level_.end());
+    while (!tree_level_.empty()) {
+      tree_level_.erase(std::unique(tree_level_.begin(), tree_level_.end()), tree_level_.end());
+      tree_next_.clear();  // stays ascending: i / 2 is monotone
+      for (std::uint32_t i : tree_level_) {
+        if (i == 0) continue;  // a one-pixel image: its pixel is the root
+        const float v = std::max(lum_tree_[2 * std::size_t(i)], lum_tree_[2 * std::size_t(i) + 1]);
+        if (lum_tree_[i] == v) continue;
+        lum_tree_[i] = v;
+        if (i > 1) tree_next_.push_back(i / 2);
+      }
+      tree_level_.swap(tree_next_);
+    }
   }
 
   subdivision_mesh initial_mesh_, mesh_;
@@ -1091,6 +1113,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> green_first_;  // per triangle split 1:2: its first child, else invalid_id
   nld_os_queue nld_os_;                     // NLD_OS's candidates in the current view
   std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
+  std::vector<std::uint32_t> tree_level_, tree_next_;  // update_lum_tree's nodes of one level and the next
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
