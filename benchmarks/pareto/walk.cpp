@@ -23,7 +23,9 @@
 // Beside it: FILE.png (PSNR, new samples, agent and primary-ray time per frame, gnuplot) and
 // FILE.gp (its script). Printed: the goals (cached samples against restart's, per-frame PSNR
 // gap, agent time against its primary rays, agent time per batch without them, history with
-// --loop), agent against shader time per frame, and Table 1 of the paper for the three views.
+// --loop), agent time per batch after a view's first, the cached agent's pixels re-located per
+// batch (counted outside the timed calls), agent against shader time per frame, and Table 1 of
+// the paper for the three views.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -127,6 +129,7 @@ struct frame_row {
   // O(pixels)): their refine() and the take_requests, deliver and take_delta of their requests.
   std::size_t later_batches = 0;
   double later_batch_seconds = 0.0;
+  std::size_t relocated_pixels = 0;  // pixels whose leaf a batch changed (counted untimed, on request)
 };
 
 // The frame's primary rays traced alone, as the agent traces them (rays made per chunk of the
@@ -153,7 +156,7 @@ double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam
 // One frame: a new view (or a restart), then request/shade/deliver/refine until the criterion
 // stops. Every agent call is timed apart from the shader.
 frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, const infolerp::pinhole_camera& cam,
-                     bool restart, const std::vector<glm::vec3>& reference, const shade_fn& shade) {
+                     bool restart, const std::vector<glm::vec3>& reference, const shade_fn& shade, bool count_relocated) {
   infolerp::serial_executor ex;
   frame_row row;
   row.primary = primary_rays_seconds(sc, cam, infolerp::driver_options{}.grain);
@@ -170,6 +173,7 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
   std::vector<std::uint32_t> ids;
   std::vector<glm::vec3> colours;
   int batch = 0;  // the batch whose requests this iteration takes (0: the view's)
+  std::vector<std::uint32_t> leaves_before;
   for (;;) {
     t = clock_type::now();
     req.clear();
@@ -189,9 +193,12 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
     agent.take_delta(delta);
     spent += seconds_since(t);
     if (batch >= 2) row.later_batch_seconds += spent;
+    if (count_relocated) leaves_before.assign(agent.pixel_leaves().begin(), agent.pixel_leaves().end());
     t = clock_type::now();
     const infolerp::refine_progress p = agent.refine({}, ex);
     const double refining = seconds_since(t);
+    if (count_relocated && p == infolerp::refine_progress::refined)
+      for (std::size_t i = 0; i < leaves_before.size(); ++i) row.relocated_pixels += leaves_before[i] != agent.pixel_leaves()[i];
     row.agent += spent + refining;
     if (p != infolerp::refine_progress::refined) break;
     if (++batch >= 2) row.later_batch_seconds += refining, ++row.later_batches;
@@ -249,7 +256,7 @@ int pareto_walk(int argc, char** argv) {
     const infolerp::pinhole_camera cam = infolerp::support::walkthrough_path(f % period, period, width, height);
     const std::vector<glm::vec3> reference = reference_image(sc, cam, shade);
     for (int m = 0; m < 3; ++m)  // interleaved per frame
-      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade));
+      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade, m == 0));
   }
 
   std::FILE* csv = std::fopen(csv_path.c_str(), "w");
@@ -298,6 +305,12 @@ int pareto_walk(int argc, char** argv) {
     std::printf("%-15s agent per batch after a view's first (refine, take_requests, deliver, take_delta): %.2f us over %zu "
                 "batches\n",
                 names[m], nl ? 1e6 * later / double(nl) : 0.0, nl);
+    if (m == 0) {
+      std::size_t relocated = 0;
+      for (const frame_row& r : rows[m]) relocated += r.relocated_pixels;
+      std::printf("%-15s pixels re-located per batch (a split leaf's pixels follow it down): %.1f\n", names[m],
+                  nb ? double(relocated) / double(nb) : 0.0);
+    }
   }
   // History: the agent over the last 100 frames against the first 100 after the first loop.
   if (loop != 0 && frames >= loop + 200) {

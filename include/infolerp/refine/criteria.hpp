@@ -238,7 +238,9 @@ std::size_t select_for_refinement(const refinement_frame& f, const criteria_opti
 }
 inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
                                          std::vector<std::uint32_t>& out) {
-  return select_for_refinement(f, o, st, out, [&](std::vector<std::uint32_t>& ids, std::size_t limit) { select_nld_os(f, o, ids, limit); });
+  return select_for_refinement(f, o, st, out, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
+    select_nld_os(f, o, ids, limit);
+  });
 }
 
 }  // namespace infolerp

@@ -38,7 +38,8 @@ class nld_os_queue {
   void add(std::uint32_t t) { pending_.push_back(t); }
 
   // Appends up to `limit` ids to `out` (see the prologue).
-  void select(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out, std::size_t limit) {
+  void select(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out,
+              std::size_t limit) {
     const double image = double(f.width) * double(f.height);
     for (std::uint32_t t : pending_) {
       if (!visible_leaf(f, t)) continue;
@@ -85,7 +86,8 @@ class nld_os_queue {
 
   // Up to `need` leaves with S > S_req by (S, id): pops while S can still reach the cut; the
   // popped leaves not taken go back on the heap.
-  void take_by_s(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out, std::size_t need) {
+  void take_by_s(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out,
+                 std::size_t need) {
     taken_.clear();
     while (!heap_.empty()) {
       const entry e = heap_.front();

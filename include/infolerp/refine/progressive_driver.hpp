@@ -355,8 +355,8 @@ class progressive_refiner {
   // nld_os_queue.hpp; NLD_IS and RND: criteria.hpp) + O(R) splits + O(new triangles · log)
   // (finding the split leaves) + O(pixels of the split leaves · level) for the re-location +
   // O(subtrees under the split leaves' parents) for the shown cut + O(pixels whose shown
-  // triangle changed · log pixels); the view's first batch also builds its luminance image,
-  // O(pixels).
+  // triangle changed + max-tree nodes that changed); the view's first batch also builds its
+  // luminance image, O(pixels).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
@@ -1042,8 +1042,8 @@ class progressive_refiner {
   // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
   // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
   // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
-  // 1, pixel p at n + p). O(pixels) per view; per batch O(dirty pixels · log) for their sort and
-  // the tree nodes whose maximum changed.
+  // 1, pixel p at n + p). O(pixels) per view; per batch O(dirty pixels + tree nodes whose
+  // maximum changed).
   template <class E>
   void luminance_image(E&& exec) {
     const std::size_t n = pixel_leaf_.size();
@@ -1062,7 +1062,8 @@ class progressive_refiner {
           const float l = pixel_luminance_[p] = luminance(pixel_colour(p));
           if (lum_tree_[n + p] == l) continue;
           lum_tree_[n + p] = l;
-          tree_level_.push_back(static_cast<std::uint32_t>((n + p) / 2));
+          const auto parent = static_cast<std::uint32_t>((n + p) / 2);
+          if (tree_level_.empty() || tree_level_.back() != parent) tree_level_.push_back(parent);
         }
       update_lum_tree();
     }
@@ -1071,20 +1072,20 @@ class progressive_refiner {
     l_max_ = n == 0 ? 0.0f : std::max(0.0f, lum_tree_[1]);
   }
 
-  // The max-tree's nodes above changed pixels, one level at a time: a node is recomputed once
-  // (its changed children share it) and its parent only when its own value changed.
-  // O(changed nodes + sort of the changed pixels).
+  // The max-tree's nodes above changed pixels, one round at a time: each queued node is
+  // recomputed from its children and queues its parent only when its own value changed, so the
+  // rounds end once no maximum changes, and a node whose child changed later (pixels sit at two
+  // depths when the pixel count is not a power of two) is queued again and recomputed after it.
+  // O(changed nodes + repeats), no sorting.
   void update_lum_tree() {
-    std::sort(tree_level_.begin(), tree_level_.end());
     while (!tree_level_.empty()) {
-      tree_level_.erase(std::unique(tree_level_.begin(), tree_level_.end()), tree_level_.end());
-      tree_next_.clear();  // stays ascending: i / 2 is monotone
+      tree_next_.clear();
       for (std::uint32_t i : tree_level_) {
         if (i == 0) continue;  // a one-pixel image: its pixel is the root
         const float v = std::max(lum_tree_[2 * std::size_t(i)], lum_tree_[2 * std::size_t(i) + 1]);
         if (lum_tree_[i] == v) continue;
         lum_tree_[i] = v;
-        if (i > 1) tree_next_.push_back(i / 2);
+        if (i > 1 && (tree_next_.empty() || tree_next_.back() != i / 2)) tree_next_.push_back(i / 2);
       }
       tree_level_.swap(tree_next_);
     }
@@ -1113,7 +1114,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> green_first_;  // per triangle split 1:2: its first child, else invalid_id
   nld_os_queue nld_os_;                     // NLD_OS's candidates in the current view
   std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
-  std::vector<std::uint32_t> tree_level_, tree_next_;  // update_lum_tree's nodes of one level and the next
+  std::vector<std::uint32_t> tree_level_, tree_next_;  // update_lum_tree's nodes of one round and the next
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
