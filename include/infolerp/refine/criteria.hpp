@@ -97,7 +97,7 @@ struct refinement_frame {
   std::span<const std::uint32_t> pixel_leaf;       // per pixel: leaf shown, or invalid_id (background)
   std::span<const float> pixel_luminance;          // per pixel: interpolated luminance (NLD_IS only)
   std::span<const std::uint32_t> leaf_pixels;      // per triangle: pixels it covers (projected area)
-  std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, ascending
+  std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, in any order
   std::span<const float> vertex_luminance;         // per vertex (valid for vertices of visible leaves)
   float l_max = 0.0f;                              // L_max: largest luminance of the current image
   std::size_t view_samples = 0;                    // shading samples requested since the view was set
