@@ -41,6 +41,7 @@ class nld_os_queue {
   void select(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out,
               std::size_t limit) {
     const double image = double(f.width) * double(f.height);
+    const std::size_t kept = heap_.size();
     for (std::uint32_t t : pending_) {
       if (!visible_leaf(f, t)) continue;
       const auto px = f.leaf_pixels[t];
@@ -50,10 +51,15 @@ class nld_os_queue {
         const glm::uvec3 v = f.mesh->triangle(t).vertices;
         const float L[3] = {f.vertex_luminance[v.x], f.vertex_luminance[v.y], f.vertex_luminance[v.z]};
         heap_.push_back({nld_pair_sum(L), t});
-        std::push_heap(heap_.begin(), heap_.end(), below);
       }
     }
     pending_.clear();
+    if (heap_.size() - kept > kept / 8) {  // many new candidates (a new view): O(heap) in one go
+      std::make_heap(heap_.begin(), heap_.end(), below);
+    } else {
+      for (std::size_t i = kept; i < heap_.size(); ++i)
+        std::push_heap(heap_.begin(), heap_.begin() + static_cast<std::ptrdiff_t>(i + 1), below);
+    }
     const std::size_t forced = take_forced(f, out, limit);
     if (forced < limit) take_by_s(f, o, out, limit - forced);
   }

@@ -912,7 +912,7 @@ class progressive_refiner {
   // O(visible · level).
   void update_display() {
     next_display_clock();
-    merged_.clear();  // the new shown set: leaves shown themselves, then ancestors, each once
+    merged_.clear();  // the new shown set: leaves shown themselves (ascending as visible_ is), then ancestors
     shown_above_.clear();
     for (std::uint32_t leaf : visible_.sorted()) {
       path_.clear();
@@ -929,8 +929,12 @@ class progressive_refiner {
       else if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
         shown_mark_[above.shown] = display_clock_, shown_above_.push_back(above.shown);
     }
-    merged_.insert(merged_.end(), shown_above_.begin(), shown_above_.end());
-    std::sort(merged_.begin(), merged_.end());
+    if (!shown_above_.empty()) {  // sorting only the ancestors: O(shown + ancestors · log)
+      std::sort(shown_above_.begin(), shown_above_.end());
+      scratch_.resize(merged_.size() + shown_above_.size());
+      std::merge(merged_.begin(), merged_.end(), shown_above_.begin(), shown_above_.end(), scratch_.begin());
+      merged_.swap(scratch_);
+    }
     // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
     std::size_t kept = 0;
     for (std::uint32_t t : merged_) kept += shown_.contains(t);
@@ -1117,7 +1121,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
-  std::vector<std::uint32_t> shown_above_, merged_;
+  std::vector<std::uint32_t> shown_above_, merged_, scratch_;
   std::vector<std::uint32_t> shown_count_;  // per triangle: visible leaves showing it
   struct waiter {
     std::uint32_t triangle, next;
