@@ -457,7 +457,8 @@ class progressive_refiner {
     f.height = height_;
     f.mesh = &mesh_;
     f.pixel_leaf = pixel_leaf_;
-    f.pixel_luminance = pixel_luminance_;
+    const std::size_t n = pixel_leaf_.size();  // the max-tree's leaves are the pixel luminances
+    if (lum_tree_.size() == 2 * n) f.pixel_luminance = std::span<const float>(lum_tree_).subspan(n);
     f.leaf_pixels = leaf_pixels_;
     f.visible = visible_.unordered();
     f.vertex_luminance = luminance_;
@@ -550,7 +551,7 @@ class progressive_refiner {
     selected_.clear();
     state_ = criterion_state{};
     state_.rng = splitmix64{options_.criteria.seed};
-    pixel_luminance_.clear();
+    lum_tree_.clear();
     in_view_.clear();
     visible_.reset();
     in_sent_.clear();
@@ -1045,16 +1046,15 @@ class progressive_refiner {
   // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
   // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
   // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
-  // 1, pixel p at n + p). O(pixels) per view; per batch O(dirty pixels + tree nodes whose
-  // maximum changed).
+  // 1, pixel p's luminance at n + p: the leaves are the luminance image NLD_IS reads).
+  // O(pixels) per view; per batch O(dirty pixels + tree nodes whose maximum changed).
   template <class E>
   void luminance_image(E&& exec) {
     const std::size_t n = pixel_leaf_.size();
     if (all_dirty_) {
-      pixel_luminance_.resize(n);
       lum_tree_.resize(2 * n);
       exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = pixel_luminance_[p] = luminance(pixel_colour(p));
+        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = luminance(pixel_colour(p));
       });
       for (std::size_t i = n; i-- > 1;) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
       all_dirty_ = false;
@@ -1062,7 +1062,7 @@ class progressive_refiner {
       tree_level_.clear();  // parents of the pixels whose value changed
       for (std::uint32_t leaf : dirty_)
         for (std::uint32_t p = leaf_head_[leaf]; p != invalid_id; p = pixel_next_[p]) {
-          const float l = pixel_luminance_[p] = luminance(pixel_colour(p));
+          const float l = luminance(pixel_colour(p));
           if (lum_tree_[n + p] == l) continue;
           lum_tree_[n + p] = l;
           const auto parent = static_cast<std::uint32_t>((n + p) / 2);
@@ -1100,7 +1100,6 @@ class progressive_refiner {
   std::uint32_t width_ = 0, height_ = 0;
   std::vector<std::uint32_t> pixel_leaf_;
   std::vector<glm::vec3> pixel_weights_;
-  std::vector<float> pixel_luminance_;
   std::vector<std::uint32_t> leaf_pixels_;
   id_set visible_;                          // the visible leaves
   std::vector<std::uint32_t> in_view_;     // per triangle: clock_ when it or a descendant is visible
@@ -1116,7 +1115,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> split_;        // a batch's split visible leaves
   std::vector<std::uint32_t> green_first_;  // per triangle split 1:2: its first child, else invalid_id
   nld_os_queue nld_os_;                     // NLD_OS's candidates in the current view
-  std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
+  std::vector<float> lum_tree_;            // max-tree whose leaves are the pixel luminances (luminance_image)
   std::vector<std::uint32_t> tree_level_, tree_next_;  // update_lum_tree's nodes of one round and the next
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
