@@ -15,13 +15,17 @@
 // each method's frame the same frame's primary rays are traced alone (same tracer, same
 // chunks) as primary_seconds. Serial executor, so all times share one core.
 //
-// CSV: method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches
-// (samples: newly shaded in the frame; psnr_db: the frame's final image against the per-pixel
-// reference of that frame; batches: batches of R run in the frame).
+// CSV: method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches,
+// later_batch_seconds,later_batches (samples: newly shaded in the frame; psnr_db: the frame's
+// final image against the per-pixel reference of that frame; batches: batches of R run in the
+// frame; later_*: the frame's batches after its first, which alone builds the view's luminance
+// image, and the agent time of their refine and of their requests' take, deliver and delta).
 // Beside it: FILE.png (PSNR, new samples, agent and primary-ray time per frame, gnuplot) and
 // FILE.gp (its script). Printed: the goals (cached samples against restart's, per-frame PSNR
 // gap, agent time against its primary rays, agent time per batch without them, history with
-// --loop), agent against shader time per frame, and Table 1 of the paper for the three views.
+// --loop), agent time per batch after a view's first, the cached agent's pixels re-located per
+// batch (counted outside the timed calls), agent against shader time per frame, and Table 1 of
+// the paper for the three views.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -121,6 +125,11 @@ infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_c
 struct frame_row {
   std::size_t samples = 0, batches = 0;
   double psnr_db = 0.0, agent = 0.0, shader = 0.0, primary = 0.0;
+  // The batches after a view's first (its first refine() also builds the view's luminance image,
+  // O(pixels)): their refine() and the take_requests, deliver and take_delta of their requests.
+  std::size_t later_batches = 0;
+  double later_batch_seconds = 0.0;
+  std::size_t relocated_pixels = 0;  // pixels whose leaf a batch changed (counted untimed, on request)
 };
 
 // The frame's primary rays traced alone, as the agent traces them (rays made per chunk of the
@@ -147,7 +156,7 @@ double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam
 // One frame: a new view (or a restart), then request/shade/deliver/refine until the criterion
 // stops. Every agent call is timed apart from the shader.
 frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, const infolerp::pinhole_camera& cam,
-                     bool restart, const std::vector<glm::vec3>& reference, const shade_fn& shade) {
+                     bool restart, const std::vector<glm::vec3>& reference, const shade_fn& shade, bool count_relocated) {
   infolerp::serial_executor ex;
   frame_row row;
   row.primary = primary_rays_seconds(sc, cam, infolerp::driver_options{}.grain);
@@ -163,11 +172,13 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
   std::vector<infolerp::shading_point> req;
   std::vector<std::uint32_t> ids;
   std::vector<glm::vec3> colours;
+  int batch = 0;  // the batch whose requests this iteration takes (0: the view's)
+  std::vector<std::uint32_t> leaves_before;
   for (;;) {
     t = clock_type::now();
     req.clear();
     agent.take_requests(req);
-    row.agent += seconds_since(t);
+    double spent = seconds_since(t);
     t = clock_type::now();
     ids.resize(req.size());
     colours.resize(req.size());
@@ -180,9 +191,17 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
       std::exit(1);
     }
     agent.take_delta(delta);
+    spent += seconds_since(t);
+    if (batch >= 2) row.later_batch_seconds += spent;
+    if (count_relocated) leaves_before.assign(agent.pixel_leaves().begin(), agent.pixel_leaves().end());
+    t = clock_type::now();
     const infolerp::refine_progress p = agent.refine({}, ex);
-    row.agent += seconds_since(t);
+    const double refining = seconds_since(t);
+    if (count_relocated && p == infolerp::refine_progress::refined)
+      for (std::size_t i = 0; i < leaves_before.size(); ++i) row.relocated_pixels += leaves_before[i] != agent.pixel_leaves()[i];
+    row.agent += spent + refining;
     if (p != infolerp::refine_progress::refined) break;
+    if (++batch >= 2) row.later_batch_seconds += refining, ++row.later_batches;
   }
   row.samples = agent.samples_delivered() - before;
   row.batches = agent.report().batches;
@@ -237,7 +256,7 @@ int pareto_walk(int argc, char** argv) {
     const infolerp::pinhole_camera cam = infolerp::support::walkthrough_path(f % period, period, width, height);
     const std::vector<glm::vec3> reference = reference_image(sc, cam, shade);
     for (int m = 0; m < 3; ++m)  // interleaved per frame
-      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade));
+      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade, m == 0));
   }
 
   std::FILE* csv = std::fopen(csv_path.c_str(), "w");
@@ -245,11 +264,13 @@ int pareto_walk(int argc, char** argv) {
     std::fprintf(stderr, "cannot write %s\n", csv_path.c_str());
     return 1;
   }
-  std::fprintf(csv, "method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches\n");
+  std::fprintf(csv, "method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches,"
+                   "later_batch_seconds,later_batches\n");
   for (int m = 0; m < 3; ++m)
     for (std::uint32_t f = 0; f < frames; ++f)
-      std::fprintf(csv, "%s,%u,%zu,%.3f,%.6f,%.6f,%.6f,%zu\n", names[m], f, rows[m][f].samples, rows[m][f].psnr_db,
-                   rows[m][f].agent, rows[m][f].shader, rows[m][f].primary, rows[m][f].batches);
+      std::fprintf(csv, "%s,%u,%zu,%.3f,%.6f,%.6f,%.6f,%zu,%.6f,%zu\n", names[m], f, rows[m][f].samples, rows[m][f].psnr_db,
+                   rows[m][f].agent, rows[m][f].shader, rows[m][f].primary, rows[m][f].batches,
+                   rows[m][f].later_batch_seconds, rows[m][f].later_batches);
   std::fclose(csv);
 
   std::printf("walk: %u frames at %ux%u, street -> temple -> street%s, R = 64, 6-pixel floor, %s shader\n", frames, width,
@@ -270,16 +291,26 @@ int pareto_walk(int argc, char** argv) {
               "restart - cached = %.3f dB\n",
               frames_within, frames, worst_frame, worst_gap);
   for (int m = 0; m < 3; ++m) {
-    double mean_db = 0.0, agent = 0.0, primary = 0.0, shader = 0.0;
-    std::size_t nb = 0;
+    double mean_db = 0.0, agent = 0.0, primary = 0.0, shader = 0.0, later = 0.0;
+    std::size_t nb = 0, nl = 0;
     for (const frame_row& r : rows[m])
-      mean_db += r.psnr_db / double(frames), agent += r.agent, primary += r.primary, shader += r.shader, nb += r.batches;
+      mean_db += r.psnr_db / double(frames), agent += r.agent, primary += r.primary, shader += r.shader, nb += r.batches,
+          later += r.later_batch_seconds, nl += r.later_batches;
     // A view's own set-up (stage 1) counts as one batch of the frame.
     const double per_batch = (agent - primary) / double(nb + frames);
     std::printf("%-15s mean PSNR %.2f dB; agent %.4f s, its frames' primary rays alone %.4f s: agent / primary %.3f "
                 "(goal <= 1.5 for nld_os_cached); shader %.4f s; agent excluding primary rays per batch %.2f us "
                 "(%zu batches + %u views)\n",
                 names[m], mean_db, agent, primary, agent / primary, shader, 1e6 * per_batch, nb, frames);
+    std::printf("%-15s agent per batch after a view's first (refine, take_requests, deliver, take_delta): %.2f us over %zu "
+                "batches\n",
+                names[m], nl ? 1e6 * later / double(nl) : 0.0, nl);
+    if (m == 0) {
+      std::size_t relocated = 0;
+      for (const frame_row& r : rows[m]) relocated += r.relocated_pixels;
+      std::printf("%-15s pixels re-located per batch (a split leaf's pixels follow it down): %.1f\n", names[m],
+                  nb ? double(relocated) / double(nb) : 0.0);
+    }
   }
   // History: the agent over the last 100 frames against the first 100 after the first loop.
   if (loop != 0 && frames >= loop + 200) {

@@ -7,8 +7,10 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 #include <glm/geometric.hpp>
+#include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/brute_force_tracer.hpp"
 #include "support/procedural.hpp"
@@ -340,4 +342,93 @@ TEST_CASE("driver: options and cameras at their extremes get a status naming the
   huge = top_camera(1u << 13, (progressive_refiner::max_view_pixels >> 13) + 1);  // one row past the limit
   CHECK(r.set_view(brute_force_tracer{&m}, huge).code() == errc::bad_parameter);
   CHECK(r.visible_leaves().empty());  // nothing was taken
+}
+
+TEST_CASE("criteria: NLD_IS recurses below quadrants with S <= S_req down to pixel size and stops at its pixel fraction") {
+  // 16x16 image over the floor's two triangles (left half: 0, right half: 1), luminance 0.5
+  // everywhere but a bright 2x2 spot at (5..6, 5..6): every quadrant of the first two levels has
+  // four equal corners (S = 0), so only the recursion the paper describes (§4: each quadrant is
+  // subdivided into four, down to one pixel; S_req gates the triangle's subdivision) finds it.
+  auto mesh = subdivision_mesh::create(floor_mesh());
+  REQUIRE(mesh.ok());
+  const std::uint32_t w = 16, h = 16;
+  std::vector<std::uint32_t> pixel_leaf(w * h), leaf_pixels{128, 128};
+  std::vector<float> lum(w * h, 0.5f);
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) pixel_leaf[y * w + x] = x < 8 ? 0u : 1u;
+  for (std::uint32_t y = 5; y < 7; ++y)
+    for (std::uint32_t x = 5; x < 7; ++x) lum[y * w + x] = 1.0f;
+  const std::vector<std::uint32_t> visible{0, 1};
+  refinement_frame f;
+  f.width = w;
+  f.height = h;
+  f.mesh = &*mesh;
+  f.pixel_leaf = pixel_leaf;
+  f.pixel_luminance = lum;
+  f.leaf_pixels = leaf_pixels;
+  f.visible = visible;
+  f.l_max = 1.0f;
+  const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = 0.05f, .batch = 8, .nld_is_pixel_fraction = 0.25f};
+  std::vector<std::uint32_t> out;
+  f.view_samples = 63;  // below 0.25 · 256 pixels: the walk runs to pixel size
+  select_nld_is(f, o, out);
+  CHECK(out == std::vector<std::uint32_t>{0});  // the spot's triangle, once; the flat right half never
+  out.clear();
+  f.view_samples = 64;  // the fraction is reached: nothing more in this view
+  select_nld_is(f, o, out);
+  CHECK(out.empty());
+  std::fill(lum.begin(), lum.end(), 0.5f);  // a flat image: the walk reaches pixel size and selects nothing
+  f.view_samples = 0;
+  select_nld_is(f, o, out);
+  CHECK(out.empty());
+}
+
+TEST_CASE("criteria: NLD_OS kept between batches selects what the full scan selects, batch after batch") {
+  // A view simulated on a subdivided plane: every new leaf gets a pixel count (some none, some
+  // above the always-refine fraction) and every new vertex a luminance from five levels (so S
+  // ties between different leaves are common); L_max and the batch size change per batch.
+  auto mesh = subdivision_mesh::create(support::make_plane(6, 6, 2.0f));
+  REQUIRE(mesh.ok());
+  std::mt19937 rng(11);
+  std::vector<std::uint32_t> pixels;
+  std::vector<float> lum;
+  nld_os_queue queue;
+  const auto cover = [&](std::size_t first_triangle) {
+    std::uniform_int_distribution<int> kind(0, 19), px(1, 40), level(0, 4);
+    for (std::size_t v = lum.size(); v < mesh->vertex_count(); ++v) lum.push_back(0.25f * float(level(rng)));
+    for (std::size_t t = first_triangle; t < mesh->triangle_count(); ++t) {
+      const int k = kind(rng);
+      pixels.push_back(k == 0 ? 0u : k == 1 ? 200u : static_cast<std::uint32_t>(px(rng)));
+      if (pixels.back() > 0 && mesh->is_leaf(t)) queue.add(static_cast<std::uint32_t>(t));
+    }
+  };
+  cover(0);
+  const criteria_options o{.s_req = 0.05f, .min_pixels = 6.0f, .always_refine_fraction = 0.02f};
+  std::size_t selected = 0, batches = 0;
+  for (int batch = 0; batch < 40; ++batch) {
+    std::vector<std::uint32_t> visible;
+    mesh->leaves(visible);
+    visible.erase(std::remove_if(visible.begin(), visible.end(), [&](std::uint32_t t) { return pixels[t] == 0; }), visible.end());
+    refinement_frame f;
+    f.width = 64;
+    f.height = 64;  // 2% of the image: 81.92 pixels
+    f.mesh = &*mesh;
+    f.leaf_pixels = pixels;
+    f.visible = visible;
+    f.vertex_luminance = lum;
+    f.l_max = std::uniform_real_distribution<float>(0.8f, 1.5f)(rng);
+    const std::size_t limit = 1 + std::size_t(batch % 7) * 3;
+    std::vector<std::uint32_t> scan, kept;
+    select_nld_os(f, o, scan, limit);
+    queue.select(f, o, kept, limit);
+    INFO("batch " << batch << ", limit " << limit);
+    REQUIRE(kept == scan);
+    if (scan.empty()) break;
+    selected += scan.size(), ++batches;
+    const std::size_t before = mesh->triangle_count();
+    for (std::uint32_t t : scan) REQUIRE(mesh->split(t).ok());
+    cover(before);
+  }
+  CHECK(batches >= 10);  // the comparison ran over many batches, not one
+  CHECK(selected >= 60);
 }

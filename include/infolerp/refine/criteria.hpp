@@ -11,10 +11,14 @@
 //  - NLD_OS ranks its candidates: triangles above the `always_refine_fraction` of the image
 //    first (largest first), then by S (largest first), ties by id; it takes the first R.
 //  - NLD_IS is a best-first walk of the image quadtree: the quadrant with the largest S (over
-//    its four corner pixels) is expanded first; while S > S_req the triangle under its centre is
-//    selected (once) and its four sub-quadrants are queued, down to one pixel. It also ends
-//    (§4) once the samples requested in the current view reach `nld_is_pixel_fraction` of the
-//    pixel count (checked per batch, so the last batch may overshoot by its own requests).
+//    its four corner pixels) is expanded first; if S > S_req the triangle under its centre is
+//    selected (once), and in either case its four sub-quadrants are queued, down to one pixel
+//    (§4: the process recurses into every quadrant; S_req gates the subdivision, not the
+//    recursion, so a feature inside a quadrant with equal corners is still found). It ends
+//    (§4) when the walk reaches pixel size without a selection or once the samples requested in
+//    the current view reach `nld_is_pixel_fraction` of the pixel count (checked per batch, so
+//    the last batch may overshoot by its own requests); the paper gives no value for the
+//    fraction, so it defaults to none (infinity) and the walk's own end stops it.
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
@@ -93,7 +97,7 @@ struct refinement_frame {
   std::span<const std::uint32_t> pixel_leaf;       // per pixel: leaf shown, or invalid_id (background)
   std::span<const float> pixel_luminance;          // per pixel: interpolated luminance (NLD_IS only)
   std::span<const std::uint32_t> leaf_pixels;      // per triangle: pixels it covers (projected area)
-  std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, ascending
+  std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, in any order
   std::span<const float> vertex_luminance;         // per vertex (valid for vertices of visible leaves)
   float l_max = 0.0f;                              // L_max: largest luminance of the current image
   std::size_t view_samples = 0;                    // shading samples requested since the view was set
@@ -145,7 +149,8 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
 }
 
 // NLD_IS (§4): best-first quadtree walk over the interpolated image (see the header comment).
-// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
+// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited
+// (Q <= 4/3 · pixels; all of them in a batch that finds fewer than R); allocation O(Q).
 inline void select_nld_is(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
   if (f.width == 0 || f.height == 0) return;
   if (double(f.view_samples) >= double(o.nld_is_pixel_fraction) * double(f.width) * double(f.height)) return;
@@ -176,9 +181,8 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
   while (!heap.empty() && out.size() < goal) {
     const quad q = heap.top();
     heap.pop();
-    if (!(q.s > o.s_req)) break;  // every other quadrant has an S at most this large
     const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
-    if (leaf != invalid_id && float(f.leaf_pixels[leaf]) >= o.min_pixels &&
+    if (q.s > o.s_req && leaf != invalid_id && float(f.leaf_pixels[leaf]) >= o.min_pixels &&
         std::find(chosen.begin(), chosen.end(), leaf) == chosen.end()) {
       chosen.push_back(leaf);
       out.push_back(leaf);
@@ -212,16 +216,18 @@ inline void select_rnd(const refinement_frame& f, const criteria_options& o, cri
   }
 }
 
-// Runs the configured criterion. Returns the number of ids appended (0: nothing qualifies).
-// Complexity and allocation: those of select_nld_os / select_nld_is / select_rnd. Serial;
-// not thread-safe for the same criterion_state (RND advances its random sequence).
-inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
-                                         std::vector<std::uint32_t>& out) {
+// Runs the configured criterion, NLD_OS through nld_os(out, limit) (select_nld_os or a selection
+// kept between batches that returns the same, refine/nld_os_queue.hpp). Returns the number of
+// ids appended (0: nothing qualifies). Complexity and allocation: those of the selection used.
+// Serial; not thread-safe for the same criterion_state (RND advances its random sequence).
+template <class NldOs>
+std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
+                                  std::vector<std::uint32_t>& out, NldOs&& nld_os) {
   const std::size_t before = out.size();
   switch (o.criterion) {
     case refinement_criterion::nld_os: {
       const auto random = static_cast<std::size_t>(std::lround(double(o.random_share) * double(o.batch)));
-      select_nld_os(f, o, out, o.batch - random);
+      nld_os(out, o.batch - random);
       if (random > 0 && !st.exhausted) select_rnd(f, o, st, out, before, o.batch - (out.size() - before));
       break;
     }
@@ -229,6 +235,12 @@ inline std::size_t select_for_refinement(const refinement_frame& f, const criter
     case refinement_criterion::rnd: select_rnd(f, o, st, out, before, o.batch); break;
   }
   return out.size() - before;
+}
+inline std::size_t select_for_refinement(const refinement_frame& f, const criteria_options& o, criterion_state& st,
+                                         std::vector<std::uint32_t>& out) {
+  return select_for_refinement(f, o, st, out, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
+    select_nld_os(f, o, ids, limit);
+  });
 }
 
 }  // namespace infolerp

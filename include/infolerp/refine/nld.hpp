@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <glm/vec3.hpp>
 
@@ -28,15 +29,16 @@ inline constexpr float luminance(glm::vec3 rgb) noexcept {
   return 0.2126f * rgb.r + 0.7152f * rgb.g + 0.0722f * rgb.b;
 }
 
-// S of equation (1) over the luminances L. Accumulated in double with the mean-shifted identity
-// Σ_{i<j}(L_i − L_j)² = n·Σ_i (L_i − mean)², which cannot go negative and does not cancel.
+// The numerator of equation (1), Σ_{i<j}(L_i − L_j)², accumulated in double with the
+// mean-shifted identity Σ_{i<j}(L_i − L_j)² = n·Σ_i (L_i − mean)², which cannot go negative and
+// does not cancel; +infinity when an L_i is not finite. For a fixed L_max, S (nld_normalised) is a
+// non-decreasing function of it, so it orders triangles as S does for any L_max.
 // Complexity O(n), two passes; no allocation; thread-safe.
-inline float nld(std::span<const float> L, float L_max) noexcept {
+inline double nld_pair_sum(std::span<const float> L) noexcept {
   const std::size_t n = L.size();
-  if (n < 2 || !(L_max > 0.0f) || !std::isfinite(L_max)) return 0.0f;
   double mean = 0.0;
   for (float l : L) {
-    if (!std::isfinite(l)) return 1.0f;
+    if (!std::isfinite(l)) return std::numeric_limits<double>::infinity();
     mean += static_cast<double>(l);
   }
   mean /= static_cast<double>(n);
@@ -45,14 +47,24 @@ inline float nld(std::span<const float> L, float L_max) noexcept {
     const double d = static_cast<double>(l) - mean;
     squares += d * d;
   }
-  const double pair_sum = static_cast<double>(n) * squares;
+  return static_cast<double>(n) * squares;
+}
+
+// S of equation (1) from the pair sum of n luminances, with the special cases above. O(1).
+inline float nld_normalised(double pair_sum, std::size_t n, float L_max) noexcept {
+  if (n < 2 || !(L_max > 0.0f) || !std::isfinite(L_max)) return 0.0f;
+  if (!std::isfinite(pair_sum)) return 1.0f;  // an invalid sample
   const double pairs = static_cast<double>((n * n) / 4);  // n² div 4
   const double lmax = static_cast<double>(L_max);
   const double s = std::sqrt(pair_sum / (pairs * lmax * lmax));
   return static_cast<float>(std::min(s, 1.0));
 }
 
-// The usual cases: a triangle's three vertices (NLD_OS) and a quadrant's four corners (NLD_IS).
+// S of equation (1) over the luminances L. Complexity O(n); no allocation; thread-safe.
+inline float nld(std::span<const float> L, float L_max) noexcept {
+  if (L.size() < 2) return 0.0f;
+  return nld_normalised(nld_pair_sum(L), L.size(), L_max);
+}
 inline float nld(float a, float b, float c, float L_max) noexcept {
   const float L[3] = {a, b, c};
   return nld(std::span<const float>(L), L_max);

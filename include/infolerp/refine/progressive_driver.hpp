@@ -27,10 +27,13 @@
 // until the criterion selects nothing, the budget is reached (checked per batch) or max_batches
 // ran. Δ: triangles shown now; Δ_total: triangles sent to the visualizer since the view was set
 // (those that entered the shown set; a new view sends only what the previous one did not show).
-// Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split
-// and the visible set, never the whole image or the hierarchy outside the view; the shown cut is
-// recomputed only under what a batch split or a delivery made ready; the luminance image and
-// L_max follow the leaves whose shown triangle changed.
+// Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split,
+// never the whole image, the whole visible set or the hierarchy outside the view: the split leaves
+// are found from the triangles the batch created, NLD_OS's candidates wait in a heap the splits
+// update (nld_os_queue.hpp), the visible and shown sets change in O(1) per member and deltas are
+// built from the members that changed; the shown cut is recomputed only under what a batch split
+// or a delivery made ready; the luminance image and L_max follow the leaves whose shown triangle
+// changed. A new view is O(pixels).
 //
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
@@ -39,7 +42,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <iterator>
 #include <limits>
 #include <span>
 #include <type_traits>
@@ -54,6 +56,7 @@
 #include "infolerp/core/tracer.hpp"
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
+#include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 
 namespace infolerp {
@@ -154,8 +157,53 @@ struct display_delta {
   }
 };
 
+// A set of triangle ids with O(1) insert and erase (the last id moves into the gap) and an
+// ascending view sorted on demand. Per-id positions: 4 bytes per triangle.
+class id_set {
+ public:
+  void grow(std::size_t n) { pos_.resize(n, invalid_id); }
+  void reset() { ids_.clear(), pos_.clear(), sorted_ = true; }
+  // Replaces the contents with `ascending` (sorted, distinct). O(old size + new size).
+  void assign(std::span<const std::uint32_t> ascending) {
+    for (std::uint32_t t : ids_) pos_[t] = invalid_id;
+    ids_.assign(ascending.begin(), ascending.end());
+    for (std::size_t i = 0; i < ids_.size(); ++i) pos_[ids_[i]] = static_cast<std::uint32_t>(i);
+    sorted_ = true;
+  }
+  [[nodiscard]] bool contains(std::uint32_t t) const { return t < pos_.size() && pos_[t] != invalid_id; }
+  void insert(std::uint32_t t) {
+    sorted_ = sorted_ && (ids_.empty() || ids_.back() < t);
+    pos_[t] = static_cast<std::uint32_t>(ids_.size());
+    ids_.push_back(t);
+  }
+  void erase(std::uint32_t t) {
+    const std::uint32_t i = pos_[t], last = ids_.back();
+    ids_[i] = last;
+    pos_[last] = i;
+    ids_.pop_back();
+    pos_[t] = invalid_id;
+    sorted_ = sorted_ && i == ids_.size();
+  }
+  [[nodiscard]] std::size_t size() const noexcept { return ids_.size(); }
+  [[nodiscard]] std::span<const std::uint32_t> unordered() const noexcept { return ids_; }
+  // O(n log n) after a change that broke the order, O(1) otherwise.
+  [[nodiscard]] std::span<const std::uint32_t> sorted() const {
+    if (!sorted_) {
+      std::sort(ids_.begin(), ids_.end());
+      for (std::size_t i = 0; i < ids_.size(); ++i) pos_[ids_[i]] = static_cast<std::uint32_t>(i);
+      sorted_ = true;
+    }
+    return ids_;
+  }
+
+ private:
+  mutable std::vector<std::uint32_t> ids_, pos_;
+  mutable bool sorted_ = true;
+};
+
 // Not thread-safe: one call at a time per object (each call runs in parallel through the
-// executor). Accessors below are O(1) and allocate nothing.
+// executor). Accessors below are O(1) and allocate nothing, but visible_leaves() and
+// shown_triangles() sort in place on their first call after a change.
 class progressive_refiner {
  public:
   // Largest image a view may have (width · height): 2^25 pixels (8192 x 4096, above 8K UHD);
@@ -175,6 +223,7 @@ class progressive_refiner {
     r.mesh_ = std::move(mesh);
     r.options_ = options;
     r.state_.rng = splitmix64{options.criteria.seed};
+    r.index_green_splits();
     return r;
   }
 
@@ -230,7 +279,7 @@ class progressive_refiner {
   // differ; a vertex out of range, never requested, already delivered, or named twice; a
   // non-finite colour (names the entry). On error nothing is stored.
   // Complexity O(n + the in-view subtrees under the parents of the triangles waiting for these
-  // vertices + shown) (the shown set is brought up to date), plus O(V) when
+  // vertices) (the shown set is brought up to date), plus O(V) when
   // the cache bound evicts (once per bound/8 deliveries); allocation: the eviction's candidates.
   status deliver(std::span<const std::uint32_t> vertices, std::span<const glm::vec3> colours) {
     if (vertices.size() != colours.size())
@@ -301,10 +350,12 @@ class progressive_refiner {
   // current view, each split and followed by requests for the new visible vertices. A batch
   // needs every earlier request delivered, so without a renderer behind the call (this
   // overload) one batch runs and the next call returns `waiting` until deliveries arrive.
-  // Preconditions: a view was set. Complexity per batch: the criterion's selection
-  // (criteria.hpp) + O(R) splits + O(visible) (finding the split leaves) + O(pixels of the split
-  // leaves · level) for the re-location + O(subtrees under the split leaves' parents + shown) for
-  // the shown cut + O(pixels whose shown triangle changed · log pixels).
+  // Preconditions: a view was set. Complexity per batch: the criterion's selection (NLD_OS:
+  // nld_os_queue.hpp; NLD_IS and RND: criteria.hpp) + O(R) splits + O(new triangles · log)
+  // (finding the split leaves) + O(pixels of the split leaves · level) for the re-location +
+  // O(subtrees under the split leaves' parents) for the shown cut + O(pixels whose shown
+  // triangle changed + max-tree nodes that changed); the view's first batch also builds its
+  // luminance image, O(pixels).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
@@ -348,22 +399,22 @@ class progressive_refiner {
     return report_;
   }
 
-  // Moves the shown set forward and reports the change (§2's incremental protocol). Replaying
-  // every delta into a set reproduces shown_triangles(). O(shown); allocation: growth of out.
+  // Moves the shown set forward and reports the change (§2's incremental protocol), each list
+  // ascending. Replaying every delta into a set reproduces shown_triangles(). O(c log c) for the
+  // c triangles whose membership changed since the last delta; allocation: growth of out.
   void take_delta(display_delta& out) {
     out.clear();
-    std::size_t i = 0, j = 0;
-    while (i < sent_.size() || j < shown_.size()) {
-      if (j == shown_.size() || (i < sent_.size() && sent_[i] < shown_[j])) {
-        out.deleted.push_back(sent_[i++]);
-      } else if (i == sent_.size() || shown_[j] < sent_[i]) {
-        const std::uint32_t t = shown_[j++];
-        (newly_delivered(t) ? out.newly_shaded : out.added_from_cache).push_back(t);
-      } else {
-        ++i, ++j;
-      }
+    for (std::uint32_t t : changed_) {
+      const bool now = shown_.contains(t), was = in_sent_[t] != 0;
+      if (now && !was) (newly_delivered(t) ? out.newly_shaded : out.added_from_cache).push_back(t);
+      if (!now && was) out.deleted.push_back(t);
+      in_sent_[t] = now;
+      listed_[t] = 0;
     }
-    sent_ = shown_;
+    changed_.clear();
+    std::sort(out.added_from_cache.begin(), out.added_from_cache.end());
+    std::sort(out.deleted.begin(), out.deleted.end());
+    std::sort(out.newly_shaded.begin(), out.newly_shaded.end());
     ++delta_epoch_;
   }
 
@@ -385,12 +436,14 @@ class progressive_refiner {
   [[nodiscard]] const refinement_report& report() const noexcept { return report_; }
   [[nodiscard]] const subdivision_mesh& mesh() const noexcept { return mesh_; }
   [[nodiscard]] std::span<const std::uint32_t> pixel_leaves() const noexcept { return pixel_leaf_; }
-  [[nodiscard]] std::span<const std::uint32_t> visible_leaves() const noexcept { return visible_; }
+  // The visible leaves (ascending; sorted on the first call after a batch changed them).
+  [[nodiscard]] std::span<const std::uint32_t> visible_leaves() const { return visible_.sorted(); }
   [[nodiscard]] std::span<const std::uint32_t> leaf_pixels() const noexcept { return leaf_pixels_; }
   // The triangles the criterion selected in the last batch.
   [[nodiscard]] std::span<const std::uint32_t> last_selection() const noexcept { return selected_; }
-  // The shown set (ascending): equals visible_leaves() once every request is delivered.
-  [[nodiscard]] std::span<const std::uint32_t> shown_triangles() const noexcept { return shown_; }
+  // The shown set (ascending; sorted on the first call after it changed): equals
+  // visible_leaves() once every request is delivered.
+  [[nodiscard]] std::span<const std::uint32_t> shown_triangles() const { return shown_.sorted(); }
   // Shaded colour of a vertex (meaningful when vertex_shaded(v)).
   [[nodiscard]] glm::vec3 vertex_colour(std::size_t v) const { return colour_[v]; }
   [[nodiscard]] bool vertex_shaded(std::size_t v) const { return v < vstate_.size() && vstate_[v] == shaded; }
@@ -404,9 +457,10 @@ class progressive_refiner {
     f.height = height_;
     f.mesh = &mesh_;
     f.pixel_leaf = pixel_leaf_;
-    f.pixel_luminance = pixel_luminance_;
+    const std::size_t n = pixel_leaf_.size();  // the max-tree's leaves are the pixel luminances
+    if (lum_tree_.size() == 2 * n) f.pixel_luminance = std::span<const float>(lum_tree_).subspan(n);
     f.leaf_pixels = leaf_pixels_;
-    f.visible = visible_;
+    f.visible = visible_.unordered();
     f.vertex_luminance = luminance_;
     f.l_max = l_max_;
     f.view_samples = view_requests_;
@@ -493,12 +547,16 @@ class progressive_refiner {
 
   void reset() {
     mesh_ = initial_mesh_;
+    index_green_splits();
     selected_.clear();
     state_ = criterion_state{};
     state_.rng = splitmix64{options_.criteria.seed};
-    pixel_luminance_.clear();
+    lum_tree_.clear();
     in_view_.clear();
-    visible_.clear();
+    visible_.reset();
+    in_sent_.clear();
+    listed_.clear();
+    changed_.clear();
     leaf_pixels_.clear();
     leaf_head_.clear();
     display_of_.clear();
@@ -524,8 +582,7 @@ class progressive_refiner {
     clock_ = 0;
     view_requests_ = 0;
     delta_epoch_ = 0;
-    shown_.clear();
-    sent_.clear();
+    shown_.reset();
   }
 
   template <class Camera, class E>
@@ -580,7 +637,11 @@ class progressive_refiner {
       if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
       luminance_image(exec);  // also L_max
       selected_.clear();
-      select_for_refinement(frame(), options_.criteria, state_, selected_);
+      const refinement_frame f = frame();
+      select_for_refinement(f, options_.criteria, state_, selected_, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
+        nld_os_.select(f, options_.criteria, ids, limit);
+      });
+      const auto first_new = static_cast<std::uint32_t>(mesh_.triangle_count());
       if (selected_.empty()) {
         finished_ = true;
         report_.stage2 = figures();
@@ -592,7 +653,7 @@ class progressive_refiner {
       }
       ++report_.batches;
       report_.selections += selected_.size();
-      follow_splits();
+      follow_splits(first_new);
       render(exec);
       report_.stage2 = figures();
     }
@@ -638,6 +699,11 @@ class progressive_refiner {
     const std::size_t nt = mesh_.triangle_count(), nv = mesh_.vertex_count();
     leaf_pixels_.resize(nt, 0);
     leaf_head_.resize(nt, invalid_id);
+    green_first_.resize(nt, invalid_id);
+    visible_.grow(nt);
+    shown_.grow(nt);
+    in_sent_.resize(nt, 0);
+    listed_.resize(nt, 0);
     in_view_.resize(nt, 0);
     display_of_.resize(nt, invalid_id);
     dirty_mark_.resize(nt, 0);
@@ -666,7 +732,7 @@ class progressive_refiner {
   // outside both views costs nothing. O(pixels · level + previous visible).
   template <class E>
   void view_leaves(E&& exec) {
-    for (std::uint32_t t : visible_) leaf_pixels_[t] = 0, leaf_head_[t] = invalid_id;
+    for (std::uint32_t t : visible_.unordered()) leaf_pixels_[t] = 0, leaf_head_[t] = invalid_id;
     const std::size_t n = pixel_leaf_.size();
     exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) {
@@ -683,26 +749,57 @@ class progressive_refiner {
     for (std::size_t p = 0; p < n; ++p)
       if (pixel_leaf_[p] != invalid_id) add_pixel(static_cast<std::uint32_t>(p), pixel_leaf_[p]);
     std::sort(fresh_.begin(), fresh_.end());
-    visible_.swap(fresh_);
+    visible_.assign(fresh_);
+    nld_os_.clear();
+    if (options_.criteria.criterion == refinement_criterion::nld_os)
+      for (std::uint32_t t : fresh_) nld_os_.add(t);
     ++clock_;
     in_view_vertices_ = 0;
     all_dirty_ = true;
     waiters_.clear();
-    stamp_in_view(visible_);
+    stamp_in_view(fresh_);
     enforce_cache_bound();
     update_display();
+  }
+
+  // The first children of every 1:2 split (their parent's 1:4 resplit retires both).
+  void index_green_splits() {
+    green_first_.assign(mesh_.triangle_count(), invalid_id);
+    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t)
+      if (mesh_.triangle(t).child_count == 2) green_first_[t] = mesh_.triangle(t).first_child;
+  }
+
+  // The visible leaves a batch's splits took out of the leaf set, found from the triangles it
+  // created (ids from first_new on): a split leaf is the parent of new children, a retired 1:2
+  // child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
+  void find_split_leaves(std::uint32_t first_new) {
+    split_.clear();
+    for (std::uint32_t c = first_new; c < mesh_.triangle_count(); ++c) {
+      const std::uint32_t p = mesh_.triangle(c).parent;
+      const subdivision_triangle& n = mesh_.triangle(p);
+      if (n.first_child != c) continue;  // one visit per split (a 1:2 split resplit in this batch has another first child)
+      if (leaf_pixels_[p] > 0) split_.push_back(p);
+      if (n.child_count == 4 && green_first_[p] != invalid_id) {
+        for (std::uint32_t g = green_first_[p]; g < green_first_[p] + 2; ++g)
+          if (leaf_pixels_[g] > 0) split_.push_back(g);
+        green_first_[p] = invalid_id;
+      }
+      if (n.child_count == 2) green_first_[p] = c;
+    }
+    std::sort(split_.begin(), split_.end());
   }
 
   // After a batch's splits: only the pixels of the visible leaves that were split follow them
   // down (pixel lists), the visible set loses those leaves and gains the children that cover
   // pixels, and only the new leaves are walked up for the in-view marks and requests (the
-  // in-view set of a view only grows). O(visible + pixels of the split leaves · level).
-  void follow_splits() {
+  // in-view set of a view only grows). O(new triangles · log + pixels of the split leaves · level)
+  // (the visible set is an id_set: O(1) per leaf that leaves or enters).
+  void follow_splits(std::uint32_t first_new) {
     grow();
+    find_split_leaves(first_new);
     fresh_.clear();
     begin_display_update();
-    for (std::uint32_t t : visible_) {
-      if (mesh_.is_leaf(t)) continue;
+    for (std::uint32_t t : split_) {
       set_display(t, invalid_id);  // no longer a visible leaf
       seeds_.push_back(mesh_.triangle(t).parent != invalid_id ? mesh_.triangle(t).parent : t);
       std::uint32_t p = leaf_head_[t];
@@ -720,11 +817,10 @@ class progressive_refiner {
     if (fresh_.empty()) return finish_display_update();
     std::sort(fresh_.begin(), fresh_.end());
     for (std::uint32_t t : fresh_) mark_dirty(t);
-    visible_.erase(std::remove_if(visible_.begin(), visible_.end(), [&](std::uint32_t t) { return leaf_pixels_[t] == 0; }),
-                   visible_.end());
-    const auto middle = static_cast<std::ptrdiff_t>(visible_.size());
-    visible_.insert(visible_.end(), fresh_.begin(), fresh_.end());
-    std::inplace_merge(visible_.begin(), visible_.begin() + middle, visible_.end());
+    if (options_.criteria.criterion == refinement_criterion::nld_os)
+      for (std::uint32_t t : fresh_) nld_os_.add(t);
+    for (std::uint32_t t : split_) visible_.erase(t);
+    for (std::uint32_t t : fresh_) visible_.insert(t);
     stamp_in_view(fresh_);
     enforce_cache_bound();
     finish_display_update();
@@ -817,10 +913,9 @@ class progressive_refiner {
   // O(visible · level).
   void update_display() {
     next_display_clock();
-    previous_shown_.swap(shown_);
-    shown_.clear();  // leaves shown themselves, ascending as visible_ is
-    shown_above_.clear();  // ancestors shown for their leaves, each once
-    for (std::uint32_t leaf : visible_) {
+    merged_.clear();  // the new shown set: leaves shown themselves (ascending as visible_ is), then ancestors
+    shown_above_.clear();
+    for (std::uint32_t leaf : visible_.sorted()) {
       path_.clear();
       std::uint32_t t = leaf;
       for (; t != invalid_id && decided_[t] != display_clock_; t = mesh_.triangle(t).parent) path_.push_back(t);
@@ -831,26 +926,32 @@ class progressive_refiner {
         decision_[*it] = above;
       }
       if (display_of_[leaf] != above.shown) display_of_[leaf] = above.shown, mark_dirty(leaf);
-      if (above.shown == leaf) shown_.push_back(leaf);
+      if (above.shown == leaf) merged_.push_back(leaf);
       else if (above.shown != invalid_id && shown_mark_[above.shown] != display_clock_)
         shown_mark_[above.shown] = display_clock_, shown_above_.push_back(above.shown);
     }
     if (!shown_above_.empty()) {  // sorting only the ancestors: O(shown + ancestors · log)
       std::sort(shown_above_.begin(), shown_above_.end());
-      merged_.resize(shown_.size() + shown_above_.size());
-      std::merge(shown_.begin(), shown_.end(), shown_above_.begin(), shown_above_.end(), merged_.begin());
-      shown_.swap(merged_);
+      scratch_.resize(merged_.size() + shown_above_.size());
+      std::merge(merged_.begin(), merged_.end(), shown_above_.begin(), shown_above_.end(), scratch_.begin());
+      merged_.swap(scratch_);
     }
-    for (std::uint32_t t : previous_shown_) shown_count_[t] = 0;
-    for (std::uint32_t leaf : visible_)
-      if (display_of_[leaf] != invalid_id) ++shown_count_[display_of_[leaf]];
     // Table 1's Δ_total: the triangles that entered the shown set (sent to the visualizer).
     std::size_t kept = 0;
-    for (std::size_t i = 0, j = 0; i < shown_.size() && j < previous_shown_.size();)
-      if (shown_[i] < previous_shown_[j]) ++i;
-      else if (previous_shown_[j] < shown_[i]) ++j;
-      else ++kept, ++i, ++j;
-    sent_total_ += shown_.size() - kept;
+    for (std::uint32_t t : merged_) kept += shown_.contains(t);
+    sent_total_ += merged_.size() - kept;
+    for (std::uint32_t t : shown_.unordered()) shown_count_[t] = 0, note_change(t);
+    for (std::uint32_t t : merged_) note_change(t);
+    shown_.assign(merged_);
+    for (std::uint32_t leaf : visible_.unordered())
+      if (display_of_[leaf] != invalid_id) ++shown_count_[display_of_[leaf]];
+  }
+
+  // A triangle whose membership in the shown set may have changed since the last delta.
+  void note_change(std::uint32_t t) {
+    if (listed_[t]) return;
+    listed_[t] = 1;
+    changed_.push_back(t);
   }
 
   // The shown cut brought up to date under seed triangles only (split leaves' parents, parents of
@@ -896,21 +997,15 @@ class progressive_refiner {
           if (in_view_[c] == clock_) stack_.push_back(c);
       }
     }
-    added_.clear();
-    removed_.clear();
+    std::size_t added = 0;
     for (const touched_triangle& x : touched_) {
       const bool now = shown_count_[x.triangle] > 0;
-      if (now && !x.was) added_.push_back(x.triangle);
-      if (!now && x.was) removed_.push_back(x.triangle);
+      if (now == x.was) continue;
+      if (now) shown_.insert(x.triangle), ++added;
+      else shown_.erase(x.triangle);
+      note_change(x.triangle);
     }
-    if (added_.empty() && removed_.empty()) return;
-    std::sort(added_.begin(), added_.end());
-    std::sort(removed_.begin(), removed_.end());
-    merged_.clear();
-    std::set_difference(shown_.begin(), shown_.end(), removed_.begin(), removed_.end(), std::back_inserter(merged_));
-    shown_.resize(merged_.size() + added_.size());
-    std::merge(merged_.begin(), merged_.end(), added_.begin(), added_.end(), shown_.begin());
-    sent_total_ += added_.size();
+    sent_total_ += added;
   }
 
   // Least recently visible first (ties by id), never a vertex of the current view. Past the bound
@@ -951,30 +1046,52 @@ class progressive_refiner {
   // The interpolated luminance per pixel and L_max, its maximum over the image (§4). After a new
   // view every pixel is computed; afterwards only the pixels of leaves marked dirty (split, or
   // shown through another triangle), and L_max comes from a max-tree over the pixels (root at
-  // 1, pixel p at n + p). O(pixels) per view, O(dirty pixels · log pixels) per batch.
+  // 1, pixel p's luminance at n + p: the leaves are the luminance image NLD_IS reads).
+  // O(pixels) per view; per batch O(dirty pixels + tree nodes whose maximum changed).
   template <class E>
   void luminance_image(E&& exec) {
     const std::size_t n = pixel_leaf_.size();
     if (all_dirty_) {
-      pixel_luminance_.resize(n);
       lum_tree_.resize(2 * n);
       exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = pixel_luminance_[p] = luminance(pixel_colour(p));
+        for (std::size_t p = begin; p < end; ++p) lum_tree_[n + p] = luminance(pixel_colour(p));
       });
       for (std::size_t i = n; i-- > 1;) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
       all_dirty_ = false;
     } else {
+      tree_level_.clear();  // parents of the pixels whose value changed
       for (std::uint32_t leaf : dirty_)
         for (std::uint32_t p = leaf_head_[leaf]; p != invalid_id; p = pixel_next_[p]) {
-          pixel_luminance_[p] = luminance(pixel_colour(p));
-          std::size_t i = n + p;
-          lum_tree_[i] = pixel_luminance_[p];
-          for (i /= 2; i >= 1; i /= 2) lum_tree_[i] = std::max(lum_tree_[2 * i], lum_tree_[2 * i + 1]);
+          const float l = luminance(pixel_colour(p));
+          if (lum_tree_[n + p] == l) continue;
+          lum_tree_[n + p] = l;
+          const auto parent = static_cast<std::uint32_t>((n + p) / 2);
+          if (tree_level_.empty() || tree_level_.back() != parent) tree_level_.push_back(parent);
         }
+      update_lum_tree();
     }
     dirty_.clear();
     if (++dirty_clock_ == 0) std::fill(dirty_mark_.begin(), dirty_mark_.end(), 0u), dirty_clock_ = 1;
     l_max_ = n == 0 ? 0.0f : std::max(0.0f, lum_tree_[1]);
+  }
+
+  // The max-tree's nodes above changed pixels, one round at a time: each queued node is
+  // recomputed from its children and queues its parent only when its own value changed, so the
+  // rounds end once no maximum changes, and a node whose child changed later (pixels sit at two
+  // depths when the pixel count is not a power of two) is queued again and recomputed after it.
+  // O(changed nodes + repeats), no sorting.
+  void update_lum_tree() {
+    while (!tree_level_.empty()) {
+      tree_next_.clear();
+      for (std::uint32_t i : tree_level_) {
+        if (i == 0) continue;  // a one-pixel image: its pixel is the root
+        const float v = std::max(lum_tree_[2 * std::size_t(i)], lum_tree_[2 * std::size_t(i) + 1]);
+        if (lum_tree_[i] == v) continue;
+        lum_tree_[i] = v;
+        if (i > 1 && (tree_next_.empty() || tree_next_.back() != i / 2)) tree_next_.push_back(i / 2);
+      }
+      tree_level_.swap(tree_next_);
+    }
   }
 
   subdivision_mesh initial_mesh_, mesh_;
@@ -983,9 +1100,8 @@ class progressive_refiner {
   std::uint32_t width_ = 0, height_ = 0;
   std::vector<std::uint32_t> pixel_leaf_;
   std::vector<glm::vec3> pixel_weights_;
-  std::vector<float> pixel_luminance_;
   std::vector<std::uint32_t> leaf_pixels_;
-  std::vector<std::uint32_t> visible_;
+  id_set visible_;                          // the visible leaves
   std::vector<std::uint32_t> in_view_;     // per triangle: clock_ when it or a descendant is visible
   std::vector<std::uint32_t> display_of_;  // per visible leaf: the shown triangle over it
   // The display walk's per-triangle outcome, stamped with display_clock_, and its mark of
@@ -996,11 +1112,15 @@ class progressive_refiner {
   std::vector<std::uint32_t> leaf_head_;   // per triangle: first pixel of its list (visible leaves), else invalid_id
   std::vector<std::uint32_t> pixel_next_;  // per pixel: the next pixel of its leaf's list
   std::vector<std::uint32_t> fresh_;       // leaves that gained their first pixel
-  std::vector<float> lum_tree_;            // max-tree over pixel_luminance_ (see luminance_image)
+  std::vector<std::uint32_t> split_;        // a batch's split visible leaves
+  std::vector<std::uint32_t> green_first_;  // per triangle split 1:2: its first child, else invalid_id
+  nld_os_queue nld_os_;                     // NLD_OS's candidates in the current view
+  std::vector<float> lum_tree_;            // max-tree whose leaves are the pixel luminances (luminance_image)
+  std::vector<std::uint32_t> tree_level_, tree_next_;  // update_lum_tree's nodes of one round and the next
   std::vector<std::uint32_t> dirty_, dirty_mark_;  // leaves to recompute, and their dirty_clock_ stamps
   std::uint32_t dirty_clock_ = 1;
   bool all_dirty_ = true;                  // every pixel is recomputed (a new view)
-  std::vector<std::uint32_t> previous_shown_, shown_above_, merged_;
+  std::vector<std::uint32_t> shown_above_, merged_, scratch_;
   std::vector<std::uint32_t> shown_count_;  // per triangle: visible leaves showing it
   struct waiter {
     std::uint32_t triangle, next;
@@ -1012,7 +1132,7 @@ class progressive_refiner {
     bool was;  // shown before this update
   };
   std::vector<touched_triangle> touched_;
-  std::vector<std::uint32_t> seeds_, stack_, added_, removed_;
+  std::vector<std::uint32_t> seeds_, stack_;
   std::size_t sent_total_ = 0;             // triangles that entered the shown set since the view was set
   std::vector<std::uint8_t> vstate_;       // per vertex: unshaded, requested, shaded
   std::vector<glm::vec3> colour_;
@@ -1025,7 +1145,10 @@ class progressive_refiner {
   std::size_t shaded_count_ = 0;
   std::size_t in_view_vertices_ = 0;  // vertices stamped with the current clock_
   std::size_t view_requests_ = 0;     // requests issued since the view was set
-  std::vector<std::uint32_t> shown_, sent_, path_, evict_;
+  id_set shown_;                             // the shown set
+  std::vector<std::uint8_t> in_sent_, listed_;  // per triangle: shown at the last delta; in changed_
+  std::vector<std::uint32_t> changed_;         // triangles whose membership changed since the last delta
+  std::vector<std::uint32_t> path_, evict_;
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
   std::size_t samples_ = 0;
