@@ -1,5 +1,5 @@
 // infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N]
-//                          [--size W H] [--threads N] [--ao N] [--soft N]
+//                          [--size W H] [--threads N] [--ao N] [--soft N] [--tessellate SHARE]
 // infolerp_pareto upsample --textured DIR ...   (a textured asset from disk: upsample_textured.cpp)
 //
 // Time against error of the I-Buffer upsampler and its competitors on the demo scene
@@ -34,7 +34,9 @@
 //                     reference's fixed ray sets, i.e. the best PSNR a denoiser can reach here
 // Each time is the least of --repeat N runs (default 3; the machine is shared). --only runs a
 // subset (the reference always runs), --match only the upsampler and joint-bilateral rows whose
-// setting contains TEXT (or one of TEXT|TEXT...). --diagnose prints where the I-Buffer's error and time go
+// setting contains TEXT (or one of TEXT|TEXT...). --tessellate SHARE splits the scene's triangles
+// 1:4 until none covers more than SHARE of the image (clustering paper §4.1) before anything
+// runs. --diagnose prints where the I-Buffer's error and time go
 // (feature clusters, 3 and 4 passes) instead of writing a CSV.
 // Writes the CSV (method,setting,seconds,speedup_vs_full_single,evaluated_fraction,psnr_db,ssim,
 // cpu_seconds,cpu_speedup_vs_full_single,filter_seconds: wall and process CPU time, each the least of N runs)
@@ -770,6 +772,7 @@ int pareto_upsample(int argc, char** argv) {
   std::string only, match;
   int repeat = 3;
   int width = 1025, height = 1025, threads = 0, ao = 64, soft = 16;
+  sup::demo_scene_options scene_options;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     const bool has1 = i + 1 < argc, has2 = i + 2 < argc;
@@ -791,8 +794,11 @@ int pareto_upsample(int argc, char** argv) {
       ++i;
     } else if (a == "--soft" && has1 && parse_int(argv[i + 1], 0, 4096, soft)) {
       ++i;
+    } else if (char* end = nullptr; a == "--tessellate" && has1 &&
+                                      (scene_options.tessellate = std::strtof(argv[i + 1], &end), *end == '\0' && end != argv[i + 1])) {
+      ++i;
     } else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N] [--size W H] [--threads N] [--ao N] [--soft N]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N] [--size W H] [--threads N] [--ao N] [--soft N] [--tessellate SHARE]\n");
       return 2;
     }
   }
@@ -805,11 +811,15 @@ int pareto_upsample(int argc, char** argv) {
 #pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
   sup::enable_flush_to_zero();
   const sup::embree_device device;
-  auto scene = sup::make_demo_scene(device);
+  auto scene = sup::make_demo_scene(device, scene_options);
   if (!scene) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", scene.error().message().c_str());
     return 1;
   }
+  std::size_t triangles = 0;
+  for (const auto& object : scene->objects) triangles += object.mesh.triangle_count();
+  std::printf("scene: %zu triangles (tessellated to %g of the image per triangle: %s)\n", triangles,
+              static_cast<double>(scene_options.tessellate), scene_options.tessellate > 0.0f ? "yes" : "no");
   // lowres_bilinear's grids are sized to the ibuffer rows' evaluated fractions.
   const auto listed = [&](const char* m) { return ("," + only + ",").find("," + std::string(m) + ",") != std::string::npos; };
   if (!only.empty() && listed("lowres_bilinear") && !listed("ibuffer")) {

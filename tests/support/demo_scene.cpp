@@ -8,6 +8,7 @@
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/validate.hpp"
+#include "infolerp/refine/subdivision_mesh.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
 
@@ -184,6 +185,22 @@ result<std::vector<scene_object>> load_fitted_asset(const std::string& path, flo
   return out;
 }
 
+// Clustering paper §4.1: m's triangles split 1:4 until each covers at most max_fraction of a
+// square image of camera c (subdivision_mesh::tessellate); texcoords and normals carried to
+// the new triangles and vertices (leaf_mesh).
+status tessellate_for_view(indexed_mesh& m, const camera& c, float max_fraction) {
+  auto sub = subdivision_mesh::create(m);
+  if (!sub) return sub.error();
+  const glm::mat4 view_projection = glm::perspective(glm::radians(c.vertical_fov_degrees), 1.0f, 0.05f, 1000.0f) *
+                                    glm::lookAt(c.eye, c.target, c.up);
+  sub->tessellate(screen_fraction_test{.view_projection = view_projection, .max_fraction = max_fraction});
+  std::vector<std::uint32_t> leaf_source;
+  auto leaves = sub->leaf_mesh(m, leaf_source);
+  if (!leaves) return leaves.error();
+  m = std::move(*leaves);
+  return {};
+}
+
 }  // namespace
 
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options) {
@@ -235,6 +252,13 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
     for (auto& object : *user) objects.push_back(std::move(object));
   }
 
+  const camera view{{6.5f, -8.5f, 5.0f}, {0.0f, 0.0f, 0.7f}, {0.0f, 0.0f, 1.0f}, 36.0f};
+  if (!(options.tessellate >= 0.0f && options.tessellate <= 1.0f))
+    return make_error(errc::bad_parameter, no_element, "tessellate = ", options.tessellate, ": a share of the image in [0, 1]");
+  for (auto& object : objects)
+    if (options.tessellate > 0.0f)
+      if (auto s = tessellate_for_view(object.mesh, view, options.tessellate); !s) return s;
+
   embree_scene tracer{device};
   for (const auto& object : objects) {
     auto id = tracer.add_mesh(object.mesh);
@@ -244,7 +268,7 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
 
   demo_scene scene{std::move(tracer)};
   scene.objects = std::move(objects);
-  scene.view = {{6.5f, -8.5f, 5.0f}, {0.0f, 0.0f, 0.7f}, {0.0f, 0.0f, 1.0f}, 36.0f};
+  scene.view = view;
   scene.sun = {glm::normalize(glm::vec3(0.6f, -0.35f, 0.75f)), {1.0f, 0.92f, 0.8f}};
   scene.area = {{-1.2f, -1.2f, 4.5f}, {0.0f, 2.4f, 0.0f}, {2.4f, 0.0f, 0.0f}, {2.2f, 2.2f, 2.4f}};
   return scene;

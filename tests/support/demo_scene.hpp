@@ -122,12 +122,16 @@ struct demo_scene_options {
   unsigned torus_major = 64;      // torus tessellation
   unsigned torus_minor = 24;
   unsigned ground_cells = 16;     // ground plane quads per side
+  // §4.1 of the clustering paper: every object's triangles split 1:4 (closure only) until none
+  // covers more than this share of a square image of the scene's view (0: not tessellated).
+  float tessellate = 0.0f;
 };
 
 // Builds the scene on `device` and commits its tracer. Each asset adds one object per material
 // (named "FILE [material]"), textured when the material has a diffuse texture and the mesh
 // texcoords; assets stand side by side in front of the built-in objects. Errors: an asset or
-// its texture cannot be loaded (the message names the file) or has no triangles Embree accepts.
+// its texture cannot be loaded (the message names the file) or has no triangles Embree accepts,
+// tessellate not in [0, 1].
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options = {});
 
 // Level-0 texels per world unit of `image` on mesh m: sqrt(texture area covered / surface area),
