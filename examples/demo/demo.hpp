@@ -2,19 +2,28 @@
 // What the demo's stages share. main.cpp parses the options, builds the scene and renders the
 // per-pixel reference; later stages (clusters, saliency, upsampler) are functions taking a
 // demo_context, declared in examples/demo/stage_<name>.hpp and called from main.cpp in order.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <vector>
 #include <glm/geometric.hpp>
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#endif
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#include "infolerp/core/executor.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
@@ -46,6 +55,12 @@ struct method_result {
   double evaluated = 1.0;    // fully evaluated samples per pixel
 };
 
+// Wall time of one stage (printed as it ends, listed again at the end of the run).
+struct stage_time {
+  std::string stage;
+  double seconds = 0.0;
+};
+
 struct demo_context {
   demo_options options;
   const support::demo_scene& scene;
@@ -53,6 +68,7 @@ struct demo_context {
   support::image reference;               // the full per-pixel render (filled by the first stage)
   support::render_stats reference_stats;  // its time and ray count
   std::vector<method_result> results;     // every method run so far, the reference first
+  std::vector<stage_time> times{};        // wall time of every stage so far, in order
 };
 
 // Display luma of every pixel (what SSIM compares).
@@ -83,26 +99,106 @@ inline int omp_threads(const demo_options& o) {
 #endif
 }
 
-// A one-line progress bar on stderr: call with (done, total); prints only when the
-// bar grows and ends the line at 100%. Not thread-safe (callers serialise).
-class progress_bar {
+// Progress of a long stage on stderr, quiet for its first two seconds: then on a terminal one
+// line rewritten in place ('\r', at most four times a second), otherwise a line at each 10%
+// step (at most one a second). Call update(done, total) from any thread (a mutex, try-locked, so
+// no caller waits for another's print); finish() ends the line. `loop` > 0 names which of a
+// stage's parallel loops the figure is for (see progress_executor).
+class progress_line {
  public:
-  explicit progress_bar(std::string label) : label_(std::move(label)) {}
-  void operator()(int done, int total) {
-    const int percent = total > 0 ? 100 * done / total : 100;
-    const int filled = percent / 2;
-    if (filled == last_) return;  // at most 51 updates
-    last_ = filled;
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled, "##################################################",
-                 50 - filled, "", percent);
-    if (percent == 100) std::fputc('\n', stderr);
+  using clock = std::chrono::steady_clock;
+  explicit progress_line(std::string label) : label_(std::move(label)) {}
+  progress_line(const progress_line&) = delete;
+  progress_line& operator=(const progress_line&) = delete;
+  ~progress_line() { finish(); }
+
+  void operator()(std::size_t done, std::size_t total, unsigned loop = 0) {
+    const auto now = clock::now();
+    if (now - start_ < std::chrono::seconds(2)) return;
+    const std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return;
+    const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
+    const int step = percent / 10 + 11 * static_cast<int>(loop);  // a new loop is a new step
+    if (tty_ ? now - last_ < std::chrono::milliseconds(250) : step == step_ || now - last_ < std::chrono::seconds(1)) return;
+    last_ = now, step_ = step;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    char where[32] = "";
+    if (loop > 0) std::snprintf(where, sizeof where, " (parallel loop %u)", loop);
+    std::fprintf(stderr, "%s%s: %3d%%%s, %.1f s%s", tty_ ? "\r" : "", label_.c_str(), percent, where, elapsed,
+                 tty_ ? "   " : "\n");
     std::fflush(stderr);
+    wrote_ = tty_;
+  }
+  void finish() {
+    const std::lock_guard lock(mutex_);
+    if (wrote_) std::fputc('\n', stderr);
+    wrote_ = false;
   }
 
  private:
   std::string label_;
-  int last_ = -1;
+  clock::time_point start_ = clock::now(), last_{};
+  std::mutex mutex_;
+  bool tty_ = stderr_is_terminal();
+  bool wrote_ = false;  // a terminal line is open
+  int step_ = -1;
+
+  static bool stderr_is_terminal() {
+#if __has_include(<unistd.h>)
+    return isatty(2) != 0;
+#else
+    return false;
+#endif
+  }
 };
+
+// An executor that runs on E and reports each finished range to a progress_line: what a
+// stage's library calls do shows without the library printing anything. Each parallel_for is
+// one loop (numbered from 1); done counts its finished elements. The cost is one atomic add
+// and one clock read per range.
+template <class E>
+struct progress_executor {
+  E inner;
+  progress_line* line;
+  std::shared_ptr<std::atomic<unsigned>> loops = std::make_shared<std::atomic<unsigned>>(0);
+
+  template <class F>
+  void parallel_for(std::size_t n, std::size_t grain, F&& fn) const {
+    const unsigned loop = ++*loops;
+    std::atomic<std::size_t> done{0};
+    inner.parallel_for(n, grain, [&](std::size_t b, std::size_t e) {
+      fn(b, e);
+      (*line)(done.fetch_add(e - b) + (e - b), n, loop);
+    });
+  }
+};
+
+// The executor every stage uses: OpenMP over --threads workers when built with OpenMP.
+#ifdef _OPENMP
+using stage_executor = openmp_executor;
+inline stage_executor make_executor(const demo_options& o) { return openmp_executor{o.threads}; }
+#else
+using stage_executor = serial_executor;
+inline stage_executor make_executor(const demo_options&) { return {}; }
+#endif
+
+// The stage executor reporting to `line`.
+inline progress_executor<stage_executor> with_progress(const demo_options& o, progress_line& line) {
+  return {make_executor(o), &line};
+}
+
+// Wall time since construction (steady clock).
+struct stopwatch {
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+};
+
+// Prints a stage's wall time ("time: STAGE  S s") and keeps it for the closing list.
+inline void record_time(demo_context& ctx, std::string stage, double seconds) {
+  std::printf("time: %-40s %9.3f s\n", stage.c_str(), seconds);
+  std::fflush(stdout);
+  ctx.times.push_back({std::move(stage), seconds});
+}
 
 // One line on stderr for a failed status (without the library's "infolerp: " prefix).
 inline void report(const status& s) {

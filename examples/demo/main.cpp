@@ -4,6 +4,7 @@
 // view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,
 // tradeoff.png). Any error gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
 // an unwritable output directory).
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 #include "demo.hpp"
 #include "stage_clusters.hpp"
 #include "stage_lod.hpp"
@@ -128,13 +130,16 @@ bool stage_reference(demo::demo_context& ctx) {
   const auto& o = ctx.options;
   std::printf("reference: %dx%d, AO %u rays, soft shadow %u rays, hard-shadow sun, textures, %s\n", o.width,
               o.height, o.shader.ao_rays, o.shader.soft_shadow_rays, o.shader.packets ? "16-ray packets" : "single rays");
-  demo::progress_bar bar("reference");
-  auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads, std::ref(bar));
+  demo::progress_line line("reference");
+  auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads,
+                                         [&](int done, int total) { line(static_cast<std::size_t>(done), static_cast<std::size_t>(total)); });
+  line.finish();
   if (!stats) {
     demo::report(stats.error());
     return false;
   }
   ctx.reference_stats = *stats;
+  demo::record_time(ctx, "reference", stats->seconds);
   std::printf("reference: %.3f s, %llu rays, %.2f Mrays/s\n", stats->seconds,
               static_cast<unsigned long long>(stats->rays), stats->rays_per_second() * 1e-6);
   demo::add_result(ctx, "reference",
@@ -144,9 +149,21 @@ bool stage_reference(demo::demo_context& ctx) {
   return demo::save_png(ctx, ctx.reference, "reference.png");
 }
 
+// The closing list of stage times, longest first, each with its share of the whole run.
+void print_times(const demo::demo_context& ctx, double total) {
+  std::vector<demo::stage_time> times = ctx.times;
+  double listed = 0.0;
+  for (const auto& t : times) listed += t.seconds;
+  times.push_back({"the rest (start-up, images, LOD panels)", total - listed});
+  std::stable_sort(times.begin(), times.end(), [](const auto& a, const auto& b) { return a.seconds > b.seconds; });
+  std::printf("where the time went (%.3f s in all):\n", total);
+  for (const auto& t : times) std::printf("  %-40s %9.3f s  %5.1f%%\n", t.stage.c_str(), t.seconds, 100.0 * t.seconds / total);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  const demo::stopwatch run;
   const auto options = parse_options(argc, argv);
   if (!options) return 2;
   std::error_code ec;
@@ -185,7 +202,9 @@ int main(int argc, char** argv) {
     for (const auto& [channel, value] : options->thresholds) std::printf(" %s=%g", channel.c_str(), static_cast<double>(value));
     std::printf(" (for the clusters stage)\n");
   }
-  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}};
+  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}, {}};
+  demo::record_time(ctx, "load", scene->load_seconds);
+  demo::record_time(ctx, "BVH", scene->bvh_seconds);
   if (!stage_reference(ctx)) return 1;
   support::scene_clustering clusters;
   if (!demo::stage_clusters(ctx, clusters)) return 1;
@@ -193,5 +212,6 @@ int main(int argc, char** argv) {
   if (!demo::stage_upsample(ctx, &clusters)) return 1;
   if (!demo::stage_lod(ctx)) return 1;
   if (!demo::stage_summary(ctx)) return 1;
+  print_times(ctx, run.seconds());
   return 0;
 }

@@ -1,8 +1,9 @@
 #pragma once
 // Demo stage: feature-based clustering of every scene object (clustering paper §3, Algorithm 1:
-// visibility → orientation → stretch), with a progress bar for the visibility rays, written as
-// DIR/clusters.png (the scene from the camera, each cluster a distinct colour).
-//   bool stage_clusters(const demo_context& ctx, support::scene_clustering& out);
+// visibility → orientation → stretch), written as DIR/clusters.png (the scene from the camera,
+// each cluster a distinct colour). Prints each channel's time per object and in all, and shows
+// progress through the stage's executor.
+//   bool stage_clusters(demo_context& ctx, support::scene_clustering& out);
 // out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage; the
 // clustering itself is support::cluster_by_features (tests/support/demo_clusters.hpp), which the
 // time-against-error harness uses too.
@@ -30,29 +31,42 @@ inline glm::vec3 cluster_colour(std::uint32_t k) {
   return glm::vec3(rgb + mn);
 }
 
-inline bool stage_clusters(const demo_context& ctx, support::scene_clustering& out) {
-  std::map<std::string, progress_bar> bars;
-  const auto progress = [&](const std::string& label, std::size_t done, std::size_t total) {
-    bars.try_emplace(label, "visibility " + label).first->second(static_cast<int>(done), static_cast<int>(total));
-  };
-  const auto on_object = [](const std::string& name, const mesh_clustering& r) {
+inline bool stage_clusters(demo_context& ctx, support::scene_clustering& out) {
+  static constexpr const char* channel_names[3] = {"visibility", "orientation", "stretch"};
+  double channel_seconds[3] = {0.0, 0.0, 0.0};  // summed over the objects
+  const auto on_object = [&](const std::string& name, const mesh_clustering& r) {
     std::printf("clusters %s: %u (", name.c_str(), r.cluster_count);
     for (std::size_t i = 0; i < r.channels.size(); ++i) std::printf(i ? ", %u" : "%u", r.channels[i].clusters_after);
-    std::printf(" after each channel)%s\n", r.channels[2].skipped ? ", stretch skipped: no texcoords" : "");
+    std::printf(" after each channel; ");
+    for (std::size_t i = 0; i < r.channels.size() && i < 3; ++i) {
+      const channel_report& c = r.channels[i];
+      const double seconds = c.prepare_seconds + c.init_seconds + c.growth_seconds + c.smoothing_seconds;
+      channel_seconds[i] += seconds;
+      std::printf(i ? ", %.3f" : "%.3f", seconds);
+    }
+    std::printf(" s)%s\n", r.channels[2].skipped ? ", stretch skipped: no texcoords" : "");
   };
-#ifdef _OPENMP
-  auto r = support::cluster_by_features(ctx.scene, openmp_executor{ctx.options.threads}, ctx.options.thresholds, progress, on_object);
-#else
-  auto r = support::cluster_by_features(ctx.scene, serial_executor{}, ctx.options.thresholds, progress, on_object);
-#endif
+  const stopwatch watch;
+  progress_line line("clusters");
+  auto r = support::cluster_by_features(ctx.scene, with_progress(ctx.options, line), ctx.options.thresholds, {}, on_object);
+  line.finish();
+  double rest = watch.seconds();
+  for (int i = 0; i < 3; ++i) {
+    record_time(ctx, std::string("clustering: ") + channel_names[i] + " channel", channel_seconds[i]);
+    rest -= channel_seconds[i];
+  }
+  record_time(ctx, "clustering: welding, topology, ids", rest);
   if (!r) {
     report(r.error());
     return false;
   }
   out = std::move(*r);
+  const stopwatch image_watch;
   const auto img = render_false_colour(
       ctx, [&](std::uint32_t g, std::uint32_t t, glm::vec2) { return cluster_colour(out.ids[g][t]); });
-  return save_png(ctx, img, "clusters.png");
+  const bool saved = save_png(ctx, img, "clusters.png");
+  record_time(ctx, "clusters.png", image_watch.seconds());
+  return saved;
 }
 
 }  // namespace infolerp::demo

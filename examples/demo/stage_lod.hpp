@@ -63,8 +63,10 @@ inline const indexed_mesh& lod_source(const demo_context& ctx) {
 inline bool finish_panel(demo_context& ctx, const support::embree_device& device, const indexed_mesh& m,
                          const std::vector<double>& saliency, const support::mesh_view_options& view,
                          lod_panel& p, const support::image* full) {
+  const stopwatch render_watch;
   auto imgs = support::render_mesh_views(device, m.positions, p.indices, view);
   if (!imgs) return report(imgs.error()), false;
+  record_time(ctx, "LOD view " + p.method, render_watch.seconds());
   p.img = std::move((*imgs)[0]);
   method_result r{p.method, "", p.seconds, std::numeric_limits<double>::infinity(), 1.0, 1.0};
   if (full) {
@@ -72,7 +74,9 @@ inline bool finish_panel(demo_context& ctx, const support::embree_device& device
     if (!sim) return report(sim.error()), false;
     r.psnr = sim->psnr, r.ssim = sim->ssim;
   }
-  const support::distances d = support::measure(m, saliency, p.indices);
+  const stopwatch metric_watch;
+  const support::distances d = support::measure(m, saliency, p.indices, make_executor(ctx.options));
+  record_time(ctx, "LOD metric " + p.method, metric_watch.seconds());
   char line[200];
   std::snprintf(line, sizeof line, "triangles %zu, weighted distance %.6g, Hausdorff %.6g, PSNR/SSIM against the full mesh's view",
                 p.indices.size() / 3, d.weighted, d.hausdorff);
@@ -102,12 +106,19 @@ inline bool stage_lod(demo_context& ctx) {
   using clk = std::chrono::steady_clock;
   std::vector<std::uint32_t> remap;
   const indexed_mesh m = support::weld_positions(detail::lod_source(ctx), remap);
-  auto sal = compute_saliency(m);
+  stopwatch watch;
+  progress_line line("LOD saliency");
+  auto sal = compute_saliency(m, {}, with_progress(ctx.options, line));
+  line.finish();
   if (!sal) return report(sal.error()), false;
+  record_time(ctx, "LOD saliency", watch.seconds());
+  watch = {};
   // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
   auto cl = salient_clustering(m, sal->saliency, {.clusters = clusters});
   if (!cl) return report(cl.error()), false;
+  record_time(ctx, "LOD salient clustering", watch.seconds());
+  watch = {};
   auto w = weighting_map(m, sal->saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
   auto h = make_contraction_hierarchy(m, *w, cl->cluster, cl->count);
@@ -116,6 +127,7 @@ inline bool stage_lod(demo_context& ctx) {
   if (!table) return report(table.error()), false;
   auto lod = view_dependent_lod::create(*h, *table);
   if (!lod) return report(lod.error()), false;
+  record_time(ctx, "LOD build (weights, hierarchy, table)", watch.seconds());
 
   const int side = std::max(16, std::min({ctx.options.width, ctx.options.height, 384}));
   const support::mesh_view_options view{side, side, 1, ctx.options.shader, ctx.options.threads};

@@ -1,6 +1,7 @@
 #include "support/demo_scene.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string_view>
 #include <glm/geometric.hpp>
@@ -187,6 +188,8 @@ result<std::vector<scene_object>> load_fitted_asset(const std::string& path, flo
 }  // namespace
 
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
   std::vector<scene_object> objects;
 
   // Ground: 16 x 16 units of bricks (48 rows).
@@ -235,6 +238,7 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
     for (auto& object : *user) objects.push_back(std::move(object));
   }
 
+  const auto t1 = clock::now();
   embree_scene tracer{device};
   for (const auto& object : objects) {
     auto id = tracer.add_mesh(object.mesh);
@@ -244,6 +248,8 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
 
   demo_scene scene{std::move(tracer)};
   scene.objects = std::move(objects);
+  scene.load_seconds = std::chrono::duration<double>(t1 - t0).count();
+  scene.bvh_seconds = std::chrono::duration<double>(clock::now() - t1).count();
   scene.view = {{6.5f, -8.5f, 5.0f}, {0.0f, 0.0f, 0.7f}, {0.0f, 0.0f, 1.0f}, 36.0f};
   scene.sun = {glm::normalize(glm::vec3(0.6f, -0.35f, 0.75f)), {1.0f, 0.92f, 0.8f}};
   scene.area = {{-1.2f, -1.2f, 4.5f}, {0.0f, 2.4f, 0.0f}, {2.4f, 0.0f, 0.0f}, {2.2f, 2.2f, 2.4f}};

@@ -110,6 +110,8 @@ struct demo_scene {
   glm::vec3 ambient{0.25f, 0.28f, 0.34f};  // sky light reaching an unoccluded surface (scaled by AO)
   float ao_radius = 1.5f;               // ambient-occlusion rays look this far
   float ray_offset = 1e-3f;             // secondary rays start this far off the surface
+  double load_seconds = 0.0;            // make_demo_scene's wall time making and loading the objects
+  double bvh_seconds = 0.0;             // and building the tracer's BVH (Embree commit)
 
   explicit demo_scene(embree_scene t) : tracer(std::move(t)) {}
 };
