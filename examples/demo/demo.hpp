@@ -39,6 +39,8 @@ struct demo_options {
   int threads = 0;                   // --threads N (0 = all cores); every stage uses this many
   std::filesystem::path out_dir = "infolerp-out";  // --out DIR
   std::vector<std::string> mesh_paths;  // --mesh FILE, repeatable (none: built-in scene only)
+  std::vector<std::string> mesh_groups;  // per mesh path: the --group NAME before it ("" when none)
+  bool z_up = false;                 // --up z: the assets are Z-up (default y: Y-up)
   support::shader_options shader;    // --ao N, --soft N
   std::uint32_t passes = 4;          // --passes K: I-Buffer passes of ibuffer.png; 0 = auto (pass controller)
   std::map<std::string, float> thresholds;  // --threshold CHANNEL=VALUE: channel (visibility,
@@ -69,6 +71,8 @@ struct demo_context {
   support::render_stats reference_stats;  // its time and ray count
   std::vector<method_result> results;     // every method run so far, the reference first
   std::vector<stage_time> times{};        // wall time of every stage so far, in order
+  std::vector<std::vector<double>> welded_saliency{};  // per object: saliency over its welded vertices
+                                                       // (saliency stage; the LOD stage reuses it)
 };
 
 // Display luma of every pixel (what SSIM compares).

@@ -29,7 +29,11 @@ namespace {
 constexpr const char* usage =
     "usage: infolerp_demo [options]\n"
     "  --mesh FILE     add an asset to the built-in scene (repeatable): OBJ+MTL, glTF/GLB, PLY, OFF\n"
-    "                  (via assimp); one object per material, shaded with its diffuse texture\n"
+    "                  (via assimp); one object per material, shaded with its diffuse texture;\n"
+    "                  each file (or group) is scaled to the same size and placed in a row\n"
+    "  --group NAME    the --mesh files after this, up to the next --group, belong together: they\n"
+    "                  keep their relative placement and scale (e.g. a car body and its wheels)\n"
+    "  --up y|z        the assets' up axis (default y; z for Z-up files, as many game assets)\n"
     "  --size W H      image size in pixels (default 1025 1025)\n"
     "  --passes K|auto I-Buffer passes of ibuffer.png (1-16, default 4); auto: the pass controller\n"
     "                  (frame-time bounds 1/60-1/30 s, at most 4 passes)\n"
@@ -70,6 +74,7 @@ bool parse_int(std::string_view text, int lo, int hi, int& out) {
 // Parses argv; on error prints one line and returns nothing. --help prints usage and exits 0.
 std::optional<demo::demo_options> parse_options(int argc, char** argv) {
   demo::demo_options o;
+  std::string group;  // the current --group ("" before the first)
   auto fail = [](const std::string& message) {
     std::fprintf(stderr, "infolerp_demo: %s (try --help)\n", message.c_str());
     return std::nullopt;
@@ -89,6 +94,14 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
     } else if (arg == "--mesh") {
       if (!need(1)) return fail("--mesh needs a file name");
       o.mesh_paths.emplace_back(argv[++i]);
+      o.mesh_groups.push_back(group);
+    } else if (arg == "--group") {
+      if (!need(1)) return fail("--group needs a name");
+      group = argv[++i];
+    } else if (arg == "--up") {
+      if (!need(1) || (std::string_view(argv[i + 1]) != "y" && std::string_view(argv[i + 1]) != "z"))
+        return fail("--up needs y or z");
+      o.z_up = std::string_view(argv[++i]) == "z";
     } else if (arg == "--size") {
       if (!need(2) || !parse_int(argv[i + 1], 1, 16384, o.width) || !parse_int(argv[i + 2], 1, 16384, o.height))
         return fail("--size needs two integers W H in [1, 16384]");
@@ -177,7 +190,7 @@ int main(int argc, char** argv) {
   support::enable_flush_to_zero();
   const std::string embree_config = options->threads > 0 ? "threads=" + std::to_string(options->threads) : "";
   const support::embree_device device(embree_config.c_str());
-  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths});
+  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths, .mesh_groups = options->mesh_groups, .z_up = options->z_up});
   if (!scene) {
     demo::report(scene.error());
     return 1;
@@ -202,7 +215,7 @@ int main(int argc, char** argv) {
     for (const auto& [channel, value] : options->thresholds) std::printf(" %s=%g", channel.c_str(), static_cast<double>(value));
     std::printf(" (for the clusters stage)\n");
   }
-  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}, {}};
+  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}, {}, {}};
   demo::record_time(ctx, "load", scene->load_seconds);
   demo::record_time(ctx, "BVH", scene->bvh_seconds);
   if (!stage_reference(ctx)) return 1;

@@ -1,8 +1,8 @@
 #pragma once
 // Demo stage: feature-based clustering of every scene object (clustering paper §3, Algorithm 1:
 // visibility → orientation → stretch), written as DIR/clusters.png (the scene from the camera,
-// each cluster a distinct colour). Prints each channel's time per object and in all, and shows
-// progress through the stage's executor.
+// each cluster a distinct colour). Prints each channel's time per object and in all, and the
+// visibility rays' progress.
 //   bool stage_clusters(demo_context& ctx, support::scene_clustering& out);
 // out receives scene-wide cluster ids (per object, per triangle) for the upsampler stage; the
 // clustering itself is support::cluster_by_features (tests/support/demo_clusters.hpp), which the
@@ -46,10 +46,15 @@ inline bool stage_clusters(demo_context& ctx, support::scene_clustering& out) {
     }
     std::printf(" s)%s\n", r.channels[2].skipped ? ", stretch skipped: no texcoords" : "");
   };
+  // Progress: the visibility rays, the channel that grows with the mesh (the others run as
+  // thousands of small parallel loops, too short to show).
+  std::map<std::string, progress_line> lines;
+  const auto progress = [&](const std::string& label, std::size_t done, std::size_t total) {
+    lines.try_emplace(label, "clusters " + label + ": visibility rays").first->second(done, total);
+  };
   const stopwatch watch;
-  progress_line line("clusters");
-  auto r = support::cluster_by_features(ctx.scene, with_progress(ctx.options, line), ctx.options.thresholds, {}, on_object);
-  line.finish();
+  auto r = support::cluster_by_features(ctx.scene, make_executor(ctx.options), ctx.options.thresholds, progress, on_object);
+  lines.clear();
   double rest = watch.seconds();
   for (int i = 0; i < 3; ++i) {
     record_time(ctx, std::string("clustering: ") + channel_names[i] + " channel", channel_seconds[i]);

@@ -105,25 +105,33 @@ inline support::image lod_grid(const std::vector<const support::image*>& cells, 
 inline bool stage_lod(demo_context& ctx) {
   using clk = std::chrono::steady_clock;
   std::vector<std::uint32_t> remap;
-  const indexed_mesh m = support::weld_positions(detail::lod_source(ctx), remap);
+  const indexed_mesh& source = detail::lod_source(ctx);
+  const indexed_mesh m = support::weld_positions(source, remap);
+  // The saliency stage's values for this object (the same welded mesh), else computed here.
+  std::vector<double> saliency;
+  for (std::size_t g = 0; g < ctx.welded_saliency.size(); ++g)
+    if (&ctx.scene.objects[g].mesh == &source) saliency = ctx.welded_saliency[g];
+  if (saliency.empty()) {
+    const stopwatch watch;
+    progress_line line("LOD saliency");
+    auto sal = compute_saliency(m, {}, with_progress(ctx.options, line));
+    line.finish();
+    if (!sal) return report(sal.error()), false;
+    saliency = std::move(sal->saliency);
+    record_time(ctx, "LOD saliency", watch.seconds());
+  }
   stopwatch watch;
-  progress_line line("LOD saliency");
-  auto sal = compute_saliency(m, {}, with_progress(ctx.options, line));
-  line.finish();
-  if (!sal) return report(sal.error()), false;
-  record_time(ctx, "LOD saliency", watch.seconds());
-  watch = {};
   // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
-  auto cl = salient_clustering(m, sal->saliency, {.clusters = clusters});
+  auto cl = salient_clustering(m, saliency, {.clusters = clusters});
   if (!cl) return report(cl.error()), false;
   record_time(ctx, "LOD salient clustering", watch.seconds());
   watch = {};
-  auto w = weighting_map(m, sal->saliency, cl->cluster, cl->count);
+  auto w = weighting_map(m, saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
   auto h = make_contraction_hierarchy(m, *w, cl->cluster, cl->count);
   if (!h) return report(h.error()), false;
-  auto table = compute_cluster_attributes(m, sal->saliency, cl->cluster, cl->count);
+  auto table = compute_cluster_attributes(m, saliency, cl->cluster, cl->count);
   if (!table) return report(table.error()), false;
   auto lod = view_dependent_lod::create(*h, *table);
   if (!lod) return report(lod.error()), false;
@@ -136,7 +144,7 @@ inline bool stage_lod(demo_context& ctx) {
   const std::size_t nt = m.triangle_count();
   const auto* full_idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
   detail::lod_panel full{"lod-full", {full_idx, full_idx + 3 * nt}, 0.0, {}};
-  if (!detail::finish_panel(ctx, device, m, sal->saliency, view, full, nullptr)) return false;
+  if (!detail::finish_panel(ctx, device, m, saliency, view, full, nullptr)) return false;
 
   std::vector<detail::lod_panel> panels;
   std::vector<index_range> ranges(h->cluster_count);
@@ -151,7 +159,7 @@ inline bool stage_lod(demo_context& ctx) {
     ours.seconds = std::chrono::duration<double>(clk::now() - t0).count();
     if (!st) return report(st.error()), false;
     ours.indices.resize(st->indices);
-    if (!detail::finish_panel(ctx, device, m, sal->saliency, view, ours, &full.img)) return false;
+    if (!detail::finish_panel(ctx, device, m, saliency, view, ours, &full.img)) return false;
     panels.push_back(std::move(ours));
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
     detail::lod_panel theirs{std::string("lod-meshopt-") + label, std::vector<std::uint32_t>(3 * nt), 0.0, {}};
@@ -160,7 +168,7 @@ inline bool stage_lod(demo_context& ctx) {
                                            sizeof(glm::vec3), st->indices, std::numeric_limits<float>::max(), 0, nullptr);
     theirs.seconds = std::chrono::duration<double>(clk::now() - t1).count();
     theirs.indices.resize(k);
-    if (!detail::finish_panel(ctx, device, m, sal->saliency, view, theirs, &full.img)) return false;
+    if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
     panels.push_back(std::move(theirs));
 #else
     panels.push_back({});

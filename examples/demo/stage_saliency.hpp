@@ -27,7 +27,8 @@ inline glm::vec3 heat_colour(float t) {
 // Stage: saliency of every scene object (Lee et al. 2005, salient-clustering paper §III.A; each
 // object its own mesh with coincident seam vertices welded, ε relative to its own bounding box),
 // written as DIR/saliency.png: the scene from the camera, coloured by saliency interpolated from
-// the vertices, one scale for the whole scene (square-root tone curve so mid values show).
+// the vertices, one scale for the whole scene (square-root tone curve so mid values show). Each
+// object's values over its welded vertices stay in ctx.welded_saliency for the LOD stage.
 inline bool stage_saliency(demo_context& ctx) {
   std::vector<std::vector<double>> values;  // per object, per original vertex
   double top = 0.0;
@@ -42,6 +43,7 @@ inline bool stage_saliency(demo_context& ctx) {
       report(s.error());
       return false;
     }
+    ctx.welded_saliency.push_back(s->saliency);
     std::vector<double> per_vertex(remap.size());
     for (std::size_t v = 0; v < remap.size(); ++v) per_vertex[v] = s->saliency[remap[v]];
     top = std::max(top, *std::max_element(per_vertex.begin(), per_vertex.end()));

@@ -1,13 +1,20 @@
 // The demo's own measures and scene set-up (tests/support): the LOD stage's surface distance
-// and distances against brute-force minima over every triangle.
+// and distances against brute-force minima over every triangle; asset groups keeping their
+// relative placement, the up axis, and the note of an undefined OBJ material.
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <span>
+#include <string>
+#include <unistd.h>
 #include <vector>
 #include <glm/gtc/matrix_transform.hpp>
+#include "infolerp/mesh/geometry.hpp"
+#include "support/demo_scene.hpp"
 #include "support/procedural.hpp"
 #include "support/surface_distance.hpp"
 #include "support/thread_pool.hpp"
@@ -102,4 +109,102 @@ TEST_CASE("measure's shortcuts give the distances of the definition, for any exe
   const support::distances same = support::measure(m, saliency, all);
   CHECK(same.weighted == 0.0);
   CHECK(same.hausdorff == 0.0);
+}
+
+namespace {
+
+const support::embree_device& demo_device() {
+  static const support::embree_device d;
+  return d;
+}
+
+// A directory of this process for the files a test writes, removed with the object.
+struct scratch_dir {
+  std::filesystem::path path;
+  explicit scratch_dir(const std::string& name)
+      : path(std::filesystem::temp_directory_path() / ("infolerp_demo_support_" + std::to_string(::getpid())) / name) {
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~scratch_dir() { std::filesystem::remove_all(path.parent_path()); }
+  scratch_dir(const scratch_dir&) = delete;
+  scratch_dir& operator=(const scratch_dir&) = delete;
+};
+
+// An axis-aligned box lo..hi written as an OFF file at dir/name; returns its path.
+std::string write_box_off(const std::filesystem::path& dir, const std::string& name, glm::vec3 lo, glm::vec3 hi) {
+  const indexed_mesh box = support::make_box(lo, hi);
+  const std::string path = (dir / name).string();
+  std::ofstream out(path);
+  out << "OFF\n" << box.vertex_count() << ' ' << box.triangle_count() << " 0\n";
+  for (const glm::vec3& p : box.positions) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
+  for (const glm::uvec3& t : box.triangles) out << "3 " << t.x << ' ' << t.y << ' ' << t.z << '\n';
+  return path;
+}
+
+const support::scene_object& object_named(const support::demo_scene& scene, const std::string& name) {
+  for (const auto& object : scene.objects)
+    if (object.name == name) return object;
+  FAIL("no object named " << name);
+  return scene.objects.front();
+}
+
+glm::dvec3 extent_of(const indexed_mesh& m) {
+  const bounding_box b = mesh_bounds(m);
+  return b.hi - b.lo;
+}
+
+}  // namespace
+
+TEST_CASE("files of one --group keep their relative placement and scale; alone, each is fitted", "[demo][scene]") {
+  const scratch_dir dir("group");
+  // A body 4 long (along x) and a wheel of side 1 beside it, 3 units further along x.
+  const std::string body = write_box_off(dir.path, "body.off", {0, 0, 0}, {4, 1, 2});
+  const std::string wheel = write_box_off(dir.path, "wheel.off", {5, 0, 0}, {6, 1, 1});
+  const float size = 2.0f;
+
+  auto grouped = support::make_demo_scene(demo_device(), {.mesh_paths = {body, wheel}, .mesh_size = size, .mesh_groups = {"car", "car"}});
+  REQUIRE(grouped);
+  const glm::dvec3 b = extent_of(object_named(*grouped, body).mesh), w = extent_of(object_named(*grouped, wheel).mesh);
+  const double s = size / 6.0;  // the group's largest extent, 6 along x, becomes `size`
+  CHECK(b.x == Approx(4.0 * s));
+  CHECK(w.x == Approx(1.0 * s));
+  const bounding_box bb = mesh_bounds(object_named(*grouped, body).mesh), wb = mesh_bounds(object_named(*grouped, wheel).mesh);
+  CHECK(wb.lo.x - bb.lo.x == Approx(5.0 * s));  // the wheel's offset, scaled with the body
+  CHECK(wb.lo.z == Approx(bb.lo.z).margin(1e-6));  // both on the ground
+
+  auto alone = support::make_demo_scene(demo_device(), {.mesh_paths = {body, wheel}, .mesh_size = size});
+  REQUIRE(alone);
+  CHECK(extent_of(object_named(*alone, body).mesh).x == Approx(size));
+  CHECK(extent_of(object_named(*alone, wheel).mesh).x == Approx(size));  // each fitted alone
+}
+
+TEST_CASE("--up: a Y-up file is turned to the scene's Z-up, a Z-up file stays upright", "[demo][scene]") {
+  const scratch_dir dir("up");
+  const std::string tower = write_box_off(dir.path, "tower.off", {0, 0, 0}, {1, 4, 2});  // tallest along y
+  auto y_up = support::make_demo_scene(demo_device(), {.mesh_paths = {tower}, .mesh_size = 4.0f});
+  REQUIRE(y_up);
+  const glm::dvec3 e = extent_of(object_named(*y_up, tower).mesh);
+  CHECK(e.z == Approx(4.0));  // file y → scene z
+  CHECK(e.y == Approx(2.0));  // file z → scene y (depth)
+  auto z_up = support::make_demo_scene(demo_device(), {.mesh_paths = {tower}, .mesh_size = 4.0f, .z_up = true});
+  REQUIRE(z_up);
+  const glm::dvec3 f = extent_of(object_named(*z_up, tower).mesh);
+  CHECK(f.y == Approx(4.0));
+  CHECK(f.z == Approx(2.0));
+  CHECK(mesh_bounds(object_named(*z_up, tower).mesh).lo.z == Approx(0.0).margin(1e-6));  // on the ground
+}
+
+TEST_CASE("a usemtl naming a material the MTL does not define says so in the part's note", "[demo][scene]") {
+  const scratch_dir dir("material");
+  std::ofstream(dir.path / "a.mtl") << "newmtl red\nKd 1 0 0\n";
+  std::ofstream(dir.path / "a.obj") << "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n"
+                                       "usemtl red\nf 1/1 2/2 3/3\nusemtl ghost\nf 2/2 4/4 3/3\n";
+  const std::string path = (dir.path / "a.obj").string();
+  auto scene = support::make_demo_scene(demo_device(), {.mesh_paths = {path}});
+  REQUIRE(scene);
+  const std::string& ghost = object_named(*scene, path + " [ghost]").note;
+  CHECK(ghost.find("'ghost'") != std::string::npos);
+  CHECK(ghost.find("not defined") != std::string::npos);
+  CHECK(object_named(*scene, path + " [red]").note.find("not defined") == std::string::npos);
 }

@@ -124,11 +124,15 @@ struct demo_scene_options {
   unsigned torus_major = 64;      // torus tessellation
   unsigned torus_minor = 24;
   unsigned ground_cells = 16;     // ground plane quads per side
+  // Per mesh path, the group it belongs to ("" or missing: alone). A group's files are placed
+  // and scaled together, keeping their relative placement and scale (e.g. a car and its wheel).
+  std::vector<std::string> mesh_groups{};
+  bool z_up = false;              // the assets are Z-up (as this scene); false: Y-up, turned +90° about X
 };
 
 // Builds the scene on `device` and commits its tracer. Each asset adds one object per material
 // (named "FILE [material]"), textured when the material has a diffuse texture and the mesh
-// texcoords; assets stand side by side in front of the built-in objects. Errors: an asset or
+// texcoords; assets (a group counts as one) stand side by side in front of the built-in objects. Errors: an asset or
 // its texture cannot be loaded (the message names the file) or has no triangles Embree accepts.
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options = {});
 

@@ -172,7 +172,10 @@ distances measure(const indexed_mesh& m, const std::vector<double>& saliency, st
   struct partial {
     double num = 0.0, den = 0.0, max = 0.0;
   };
-  const surface_distance to_simplified(m.positions, simplified);
+  // Each hierarchy is built only when some point needs it.
+  bool all_kept = true;
+  for (std::size_t v = 0; v < used.size() && all_kept; ++v) all_kept = !used[v] || kept[v];
+  const surface_distance to_simplified(m.positions, all_kept ? std::span<const std::uint32_t>() : simplified);
   std::vector<partial> vertex_part(chunk_count(m.vertex_count(), grain));
   for_each_chunk(exec, m.vertex_count(), grain, [&](std::size_t c, std::size_t begin, std::size_t end) {
     partial& r = vertex_part[c];
@@ -187,15 +190,18 @@ distances measure(const indexed_mesh& m, const std::vector<double>& saliency, st
   for (std::size_t t = 0; t < original.size(); ++t)
     original[t] = detail::sorted_corners(m.triangles[t].x, m.triangles[t].y, m.triangles[t].z);
   std::sort(original.begin(), original.end());
+  std::vector<std::uint32_t> changed;  // simplified triangles that are not m's
+  for (std::size_t k = 0; k + 2 < simplified.size(); k += 3)
+    if (!std::binary_search(original.begin(), original.end(), detail::sorted_corners(simplified[k], simplified[k + 1], simplified[k + 2])))
+      changed.insert(changed.end(), {simplified[k], simplified[k + 1], simplified[k + 2]});
+  original = {};
   const std::span<const std::uint32_t> all(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * m.triangle_count());
-  const surface_distance to_original(m.positions, all);
-  const std::size_t nt = simplified.size() / 3;
+  const surface_distance to_original(m.positions, changed.empty() ? std::span<const std::uint32_t>() : all);
+  const std::size_t nt = changed.size() / 3;
   std::vector<double> triangle_max(chunk_count(nt, grain), 0.0);
   for_each_chunk(exec, nt, grain, [&](std::size_t c, std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
-      const std::uint32_t* k = &simplified[3 * t];
-      if (std::binary_search(original.begin(), original.end(), detail::sorted_corners(k[0], k[1], k[2]))) continue;
-      const glm::dvec3 a(m.positions[k[0]]), b(m.positions[k[1]]), e(m.positions[k[2]]);
+      const glm::dvec3 a(m.positions[changed[3 * t]]), b(m.positions[changed[3 * t + 1]]), e(m.positions[changed[3 * t + 2]]);
       for (const glm::dvec3& p : {a, b, e, 0.5 * (a + b), 0.5 * (b + e), 0.5 * (e + a), (a + b + e) / 3.0})
         triangle_max[c] = std::max(triangle_max[c], to_original(p));
     }
