@@ -33,8 +33,15 @@ inline glm::vec3 cluster_colour(std::uint32_t k) {
 
 inline bool stage_clusters(demo_context& ctx, support::scene_clustering& out) {
   static constexpr const char* channel_names[3] = {"visibility", "orientation", "stretch"};
+  // Progress: the visibility rays, the channel that grows with the mesh (the others run as
+  // thousands of small parallel loops, too short to show).
+  std::map<std::string, progress_line> lines;
+  const auto progress = [&](const std::string& label, std::size_t done, std::size_t total) {
+    lines.try_emplace(label, "clusters " + label + ": visibility rays").first->second(done, total);
+  };
   double channel_seconds[3] = {0.0, 0.0, 0.0};  // summed over the objects
   const auto on_object = [&](const std::string& name, const mesh_clustering& r) {
+    if (const auto it = lines.find(name); it != lines.end()) it->second.finish();  // stdout after the open line
     std::printf("clusters %s: %u (", name.c_str(), r.cluster_count);
     for (std::size_t i = 0; i < r.channels.size(); ++i) std::printf(i ? ", %u" : "%u", r.channels[i].clusters_after);
     std::printf(" after each channel; ");
@@ -45,12 +52,6 @@ inline bool stage_clusters(demo_context& ctx, support::scene_clustering& out) {
       std::printf(i ? ", %.3f" : "%.3f", seconds);
     }
     std::printf(" s)%s\n", r.channels[2].skipped ? ", stretch skipped: no texcoords" : "");
-  };
-  // Progress: the visibility rays, the channel that grows with the mesh (the others run as
-  // thousands of small parallel loops, too short to show).
-  std::map<std::string, progress_line> lines;
-  const auto progress = [&](const std::string& label, std::size_t done, std::size_t total) {
-    lines.try_emplace(label, "clusters " + label + ": visibility rays").first->second(done, total);
   };
   const stopwatch watch;
   auto r = support::cluster_by_features(ctx.scene, make_executor(ctx.options), ctx.options.thresholds, progress, on_object);

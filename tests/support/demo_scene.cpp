@@ -220,7 +220,8 @@ result<std::vector<scene_object>> load_fitted_group(const std::vector<std::strin
   m = glm::scale(m, glm::vec3(s));
   m = glm::translate(m, -base);
   std::vector<scene_object> out;
-  for (auto& [path, part] : parts) {
+  for (auto& [file, part] : parts) {
+    const std::string& path = file;  // named, not a binding: lambdas capture it
     indexed_mesh mesh = moved(part.mesh, m);
     if (!mesh.has_normals()) mesh.normals = vertex_normals(mesh);
     for (auto& n : mesh.normals) n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 0.0f, 1.0f);
