@@ -105,7 +105,7 @@ inline int omp_threads(const demo_options& o) {
 
 // Progress of a long stage on stderr, quiet for its first two seconds: then on a terminal one
 // line rewritten in place ('\r', at most four times a second), otherwise a line at each 10%
-// step (at most one a second). Call update(done, total) from any thread (a mutex, try-locked, so
+// step (at most one a second). Call it with (done, total) from any thread (a mutex, try-locked, so
 // no caller waits for another's print); finish() ends the line. `loop` > 0 names which of a
 // stage's parallel loops the figure is for (see progress_executor).
 class progress_line {
@@ -122,7 +122,7 @@ class progress_line {
     const std::unique_lock lock(mutex_, std::try_to_lock);
     if (!lock.owns_lock()) return;
     const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
-    const int step = percent / 10 + 11 * static_cast<int>(loop);  // a new loop is a new step
+    const auto step = static_cast<unsigned long long>(percent / 10) + 11ull * loop;  // a new loop is a new step
     if (tty_ ? now - last_ < std::chrono::milliseconds(250) : step == step_ || now - last_ < std::chrono::seconds(1)) return;
     last_ = now, step_ = step;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
@@ -145,7 +145,7 @@ class progress_line {
   std::mutex mutex_;
   bool tty_ = stderr_is_terminal();
   bool wrote_ = false;  // a terminal line is open
-  int step_ = -1;
+  unsigned long long step_ = ~0ull;
 
   static bool stderr_is_terminal() {
 #if __has_include(<unistd.h>)

@@ -2,8 +2,10 @@
 // per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
 // saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), the
 // view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,
-// tradeoff.png). Any error gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
-// an unwritable output directory).
+// tradeoff.png). Every stage prints its wall time ("time: STAGE  S s") and the run ends with
+// the list of stages, longest first; a stage past about 2 s shows progress on stderr. Any error
+// gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an
+// unreadable or malformed mesh, an unwritable output directory).
 #include <algorithm>
 #include <charconv>
 #include <cstdio>

@@ -125,7 +125,7 @@ inline bool stage_lod(demo_context& ctx) {
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
   auto cl = salient_clustering(m, saliency, {.clusters = clusters});
   if (!cl) return report(cl.error()), false;
-  record_time(ctx, "LOD salient clustering", watch.seconds());
+  record_time(ctx, "LOD salient clustering (" + std::to_string(cl->iterations) + " growth rounds)", watch.seconds());
   watch = {};
   auto w = weighting_map(m, saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
