@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
@@ -15,6 +16,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 #include <glm/geometric.hpp>
 #if __has_include(<unistd.h>)
@@ -105,9 +107,10 @@ inline int omp_threads(const demo_options& o) {
 
 // Progress of a long stage on stderr, quiet for its first two seconds: then on a terminal one
 // line rewritten in place ('\r', at most four times a second), otherwise a line at each 10%
-// step (at most one a second). Call it with (done, total) from any thread (a mutex, try-locked, so
-// no caller waits for another's print); finish() ends the line. `loop` > 0 names which of a
-// stage's parallel loops the figure is for (see progress_executor).
+// step (at most one a second; every 10 s for elapsed()). Call it with (done, total) from any
+// thread (a mutex, try-locked, so no caller waits for another's print), or elapsed() where no
+// fraction is known; finish() ends the line. `loop` > 0 names which of a stage's parallel
+// loops the figure is for (see progress_executor).
 class progress_line {
  public:
   using clock = std::chrono::steady_clock;
@@ -117,21 +120,14 @@ class progress_line {
   ~progress_line() { finish(); }
 
   void operator()(std::size_t done, std::size_t total, unsigned loop = 0) {
-    const auto now = clock::now();
-    if (now - start_ < std::chrono::seconds(2)) return;
-    const std::unique_lock lock(mutex_, std::try_to_lock);
-    if (!lock.owns_lock()) return;
     const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
-    const auto step = static_cast<unsigned long long>(percent / 10) + 11ull * loop;  // a new loop is a new step
-    if (tty_ ? now - last_ < std::chrono::milliseconds(250) : step == step_ || now - last_ < std::chrono::seconds(1)) return;
-    last_ = now, step_ = step;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    char where[32] = "";
-    if (loop > 0) std::snprintf(where, sizeof where, " (parallel loop %u)", loop);
-    std::fprintf(stderr, "%s%s: %3d%%%s, %.1f s%s", tty_ ? "\r" : "", label_.c_str(), percent, where, elapsed,
-                 tty_ ? "   " : "\n");
-    std::fflush(stderr);
-    wrote_ = tty_;
+    char text[64];
+    std::snprintf(text, sizeof text, loop > 0 ? "%3d%% (parallel loop %u)" : "%3d%%", percent, loop);
+    print(static_cast<unsigned long long>(percent / 10) + 11ull * loop, std::chrono::seconds(1), text);  // a new loop is a new step
+  }
+  void elapsed() {
+    const auto tens = std::chrono::duration_cast<std::chrono::seconds>(clock::now() - start_).count() / 10;
+    print(static_cast<unsigned long long>(tens), std::chrono::seconds(0), "running");
   }
   void finish() {
     const std::lock_guard lock(mutex_);
@@ -147,6 +143,20 @@ class progress_line {
   bool wrote_ = false;  // a terminal line is open
   unsigned long long step_ = ~0ull;
 
+  // Prints "LABEL: TEXT, S s" when due: after 2 s, then on a terminal every quarter second,
+  // otherwise when `step` changes and `gap` has passed since the last line.
+  void print(unsigned long long step, clock::duration gap, const char* text) {
+    const auto now = clock::now();
+    if (now - start_ < std::chrono::seconds(2)) return;
+    const std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return;
+    if (tty_ ? now - last_ < std::chrono::milliseconds(250) : step == step_ || now - last_ < gap) return;
+    last_ = now, step_ = step;
+    std::fprintf(stderr, "%s%s: %s, %.1f s%s", tty_ ? "\r" : "", label_.c_str(), text,
+                 std::chrono::duration<double>(now - start_).count(), tty_ ? "   " : "\n");
+    std::fflush(stderr);
+    wrote_ = tty_;
+  }
   static bool stderr_is_terminal() {
 #if __has_include(<unistd.h>)
     return isatty(2) != 0;
@@ -154,6 +164,33 @@ class progress_line {
     return false;
 #endif
   }
+};
+
+// For a stage that reports nothing (a serial library call): a thread that shows the elapsed
+// time on `line` four times a second until the heartbeat is destroyed.
+class heartbeat {
+ public:
+  explicit heartbeat(progress_line& line)
+      : thread_([this, &line] {
+          std::unique_lock lock(mutex_);
+          while (!stopped_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stop_; })) line.elapsed();
+        }) {}
+  heartbeat(const heartbeat&) = delete;
+  heartbeat& operator=(const heartbeat&) = delete;
+  ~heartbeat() {
+    {
+      const std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    stopped_.notify_one();
+    thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable stopped_;
+  bool stop_ = false;
+  std::thread thread_;  // last: starts once the members it uses exist
 };
 
 // An executor that runs on E and reports each finished range to a progress_line: what a

@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -75,7 +76,9 @@ inline bool finish_panel(demo_context& ctx, const support::embree_device& device
     r.psnr = sim->psnr, r.ssim = sim->ssim;
   }
   const stopwatch metric_watch;
-  const support::distances d = support::measure(m, saliency, p.indices, make_executor(ctx.options));
+  progress_line metric_line("LOD metric " + p.method);
+  const support::distances d = support::measure(m, saliency, p.indices, with_progress(ctx.options, metric_line));
+  metric_line.finish();
   record_time(ctx, "LOD metric " + p.method, metric_watch.seconds());
   char line[200];
   std::snprintf(line, sizeof line, "triangles %zu, weighted distance %.6g, Hausdorff %.6g, PSNR/SSIM against the full mesh's view",
@@ -123,10 +126,14 @@ inline bool stage_lod(demo_context& ctx) {
   stopwatch watch;
   // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
-  auto cl = salient_clustering(m, saliency, {.clusters = clusters});
+  progress_line cl_line("LOD salient clustering");
+  auto cl = [&] { const heartbeat beat(cl_line); return salient_clustering(m, saliency, {.clusters = clusters}); }();
+  cl_line.finish();
   if (!cl) return report(cl.error()), false;
   record_time(ctx, "LOD salient clustering (" + std::to_string(cl->iterations) + " growth rounds)", watch.seconds());
   watch = {};
+  progress_line build_line("LOD build");
+  std::optional<heartbeat> beat(std::in_place, build_line);
   auto w = weighting_map(m, saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
   auto h = make_contraction_hierarchy(m, *w, cl->cluster, cl->count);
@@ -135,6 +142,8 @@ inline bool stage_lod(demo_context& ctx) {
   if (!table) return report(table.error()), false;
   auto lod = view_dependent_lod::create(*h, *table);
   if (!lod) return report(lod.error()), false;
+  beat.reset();
+  build_line.finish();
   record_time(ctx, "LOD build (weights, hierarchy, table)", watch.seconds());
 
   const int side = std::max(16, std::min({ctx.options.width, ctx.options.height, 384}));
