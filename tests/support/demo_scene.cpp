@@ -203,7 +203,7 @@ result<std::vector<scene_object>> load_fitted_group(const std::vector<std::strin
       part.mesh = moved(part.mesh, up);
       append(all, part.mesh);
       if (std::find(undefined.begin(), undefined.end(), part.material) != undefined.end())
-        part.note = "material '" + part.material + "' is used but not defined in the MTL file: default solid colour";
+        part.note = "material '" + part.material + "' is not defined in the MTL file" + (part.note.empty() ? "" : "; " + part.note);
       parts.push_back({path, std::move(part)});
     }
   }
