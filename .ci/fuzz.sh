@@ -23,7 +23,7 @@ for t in "${targets[@]}"; do
   rm -rf "$work" && mkdir -p "$work"
   log=$tree/$t.log
   echo "fuzz: $t for ${seconds} s"
-  if ! "$tree"/tests/fuzz/"$t" -max_total_time="$seconds" -print_final_stats=1 -rss_limit_mb=2048 \
+  if ! LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0" "$tree"/tests/fuzz/"$t" -max_total_time="$seconds" -print_final_stats=1 -rss_limit_mb=2048 \
         -timeout=10 -artifact_prefix="$tree/fuzz-artifacts/$t-" "$work" tests/fuzz/corpus/"$t" >"$log" 2>&1; then
     tail -n 60 "$log"
     echo "fuzz: $t FAILED (input in $tree/fuzz-artifacts/)"

@@ -2,8 +2,8 @@
 #   MODE=errors  bad options and bad files: each gives exit code 1 or 2 (not a signal) and exactly
 #                one line on stderr that says what is wrong
 #   MODE=run     a small run (65x65, AO 4, soft 2, --threads 2, then --passes auto at 33x33):
-#                exit 0 and every output file written; then two --mesh files (33x33), each
-#                reported with what it lacks
+#                exit 0 and every output file written (each PNG a non-empty file with the PNG
+#                signature); then two --mesh files (33x33), each reported with what it lacks
 # Arguments: -DDEMO=<infolerp_demo> -DWORK_DIR=<scratch dir> -DMODE=errors|run
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
@@ -29,6 +29,12 @@ function(expect_files)
     if(size EQUAL 0)
       message(FATAL_ERROR "empty output ${f}")
     endif()
+    if(f MATCHES "\\.png$")
+      file(READ ${f} signature LIMIT 8 HEX)
+      if(NOT signature STREQUAL "89504e470d0a1a0a" OR size LESS 100)
+        message(FATAL_ERROR "not a PNG file: ${f} (${size} bytes, starts with ${signature})")
+      endif()
+    endif()
   endforeach()
 endfunction()
 
@@ -50,13 +56,17 @@ if(MODE STREQUAL "errors")
   expect_error(2 "--group needs a name" --group)
   expect_error(2 "--up needs y or z" --up x)
 
-  # Files: missing, not a mesh, truncated, an index out of range, a NaN coordinate.
+  # Files: missing, not a mesh, truncated, counts the file cannot hold, an index out of range, a
+  # NaN coordinate.
   expect_error(1 "cannot open mesh '${WORK_DIR}/missing.off'" --mesh ${WORK_DIR}/missing.off)
   expect_error(1 "cannot load mesh '${WORK_DIR}/missing.obj'" --mesh ${WORK_DIR}/missing.obj)
   file(WRITE ${WORK_DIR}/garbage.off "this is not a mesh\n")
   expect_error(1 "not an OFF file" --mesh ${WORK_DIR}/garbage.off)
-  file(WRITE ${WORK_DIR}/truncated.off "OFF\n4 2 0\n0 0 0\n1 0 0\n")
-  expect_error(1 "line 4: truncated vertex list" --mesh ${WORK_DIR}/truncated.off)
+  file(WRITE ${WORK_DIR}/truncated.off "OFF\n4 2 0\n0 0 0\n1 0 0\n# a comment long enough for the counts\n")
+  expect_error(1 "line 5: truncated vertex list" --mesh ${WORK_DIR}/truncated.off)
+  file(WRITE ${WORK_DIR}/huge.off "OFF\n1000000000000 1 0\n0 0 0\n")
+  expect_error(1 "line 2: the header's counts \\(1000000000000 vertices, 1 faces\\) need more than the file's 28 bytes"
+               --mesh ${WORK_DIR}/huge.off)
   file(WRITE ${WORK_DIR}/index.off "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 2 1 9\n")
   expect_error(1 "triangle 1 corner 2: vertex index 9 out of range \\(vertex count 4\\)" --mesh ${WORK_DIR}/index.off)
   file(WRITE ${WORK_DIR}/nan.off "OFF\n4 2 0\n0 0 0\n1 0 0\nnan 1 0\n1 1 0\n3 0 1 2\n3 2 1 3\n")
@@ -85,18 +95,18 @@ elseif(MODE STREQUAL "run")
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "small run: exit '${rc}'\n${out}\n${err}")
   endif()
-  set(files reference.png saliency.png ibuffer.png rie.png error.png lod.png summary.csv tradeoff.png)
+  set(files reference.png saliency.png ibuffer.png rie.png error.png lod.png lod_orbit.png summary.csv lod.csv tradeoff.png)
   list(TRANSFORM files PREPEND ${WORK_DIR}/out/)
   expect_files(${files})
   file(STRINGS ${WORK_DIR}/out/summary.csv rows)
   list(GET rows 0 header)
   list(LENGTH rows nrows)
   if(NOT header MATCHES "^method,seconds,speedup,psnr_db,ssim" OR nrows LESS 6 OR NOT "${rows}" MATCHES "reference,.*ibuffer-3,"
-     OR NOT "${rows}" MATCHES "lod-saliency-5,[^;]*triangles [0-9]+, weighted distance")
+     OR "${rows}" MATCHES "(^|;)lod-")
     message(FATAL_ERROR "summary.csv:\n${rows}")
   endif()
   foreach(stage IN ITEMS "load" "BVH" "reference" "clustering: visibility channel" "saliency" "LOD salient clustering"
-                         "LOD metric lod-saliency-5" "I-Buffer row ibuffer-3")
+                         "LOD metric infolerp 5%" "I-Buffer row ibuffer-3")
     if(NOT out MATCHES "\ntime: ${stage}[^\n]* [0-9.]+ s\n")
       message(FATAL_ERROR "the demo did not print the time of stage '${stage}':\n${out}")
     endif()
@@ -104,7 +114,32 @@ elseif(MODE STREQUAL "run")
   if(NOT out MATCHES "where the time went")
     message(FATAL_ERROR "no closing list of stage times:\n${out}")
   endif()
-  foreach(f IN ITEMS "reference.png" "summary.csv" "tradeoff.png")
+  # The LOD figures: their own table and lod.csv, the full mesh first, then each method at 35% and 5%.
+  file(STRINGS ${WORK_DIR}/out/lod.csv rows)
+  set(number "[0-9.e+-]+")
+  if(NOT "${rows}" MATCHES "^method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr_db,ssim;full,1.0000,[1-9][0-9]*,"
+     OR NOT "${rows}" MATCHES ";infolerp,0.0500,[1-9][0-9]*,${number},${number},${number},${number},${number}(;|$)"
+     OR NOT "${rows}" MATCHES ";infolerp,0.3500,[1-9][0-9]*,")
+    message(FATAL_ERROR "lod.csv:\n${rows}")
+  endif()
+  if(NOT out MATCHES "\nLOD method +fraction +triangles +time \\(s\\) +weighted d. +Hausdorff +PSNR \\(dB\\) +SSIM\n"
+     OR NOT out MATCHES "\ninfolerp +5% +[0-9]+ ")
+    message(FATAL_ERROR "the demo printed no LOD table:\n${out}")
+  endif()
+  # lod.png: 3 x 2 panels of 65 pixels; lod_orbit.png: 6 cameras x 2 rows (PNG header: width, height).
+  foreach(png_size IN ITEMS "lod.png:000000c300000082" "lod_orbit.png:0000018600000082")
+    string(REPLACE ":" ";" png_size "${png_size}")
+    list(GET png_size 0 f)
+    list(GET png_size 1 expected)
+    file(READ ${WORK_DIR}/out/${f} ihdr OFFSET 16 LIMIT 8 HEX)
+    if(NOT ihdr STREQUAL expected)
+      message(FATAL_ERROR "${f}: width and height ${ihdr}, expected ${expected}")
+    endif()
+  endforeach()
+  if(NOT out MATCHES "\n  camera 5: [1-9][0-9]* triangles, [0-9]+% facing it \\(full mesh: [0-9]+%\\)\n")
+    message(FATAL_ERROR "lod_orbit: no line for the sixth camera:\n${out}")
+  endif()
+  foreach(f IN ITEMS "reference.png" "lod_orbit.png" "summary.csv" "lod.csv" "tradeoff.png")
     if(NOT out MATCHES "wrote [^\n]*${f}")
       message(FATAL_ERROR "the demo did not say where ${f} went:\n${out}")
     endif()

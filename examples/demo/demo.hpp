@@ -65,6 +65,17 @@ struct stage_time {
   double seconds = 0.0;
 };
 
+// One simplified mesh of the LOD stage, for the LOD table and lod.csv.
+struct lod_result {
+  std::string method;                // "full", "infolerp" (view_dependent_lod::frame), "meshoptimizer"
+  double fraction = 1.0;             // of the full mesh's triangles asked for
+  std::size_t triangles = 0;         // drawn
+  double seconds = 0.0;              // the frame() update or the meshopt_simplify call
+  double weighted_distance = 0.0;    // saliency-weighted mean distance to the full mesh
+  double hausdorff = 0.0;            // Hausdorff distance to the full mesh
+  double psnr = 0.0, ssim = 1.0;     // of its image against the full mesh's image of the same view
+};
+
 struct demo_context {
   demo_options options;
   const support::demo_scene& scene;
@@ -72,6 +83,7 @@ struct demo_context {
   support::image reference;               // the full per-pixel render (filled by the first stage)
   support::render_stats reference_stats;  // its time and ray count
   std::vector<method_result> results;     // every method run so far, the reference first
+  std::vector<lod_result> lod_results{};  // the LOD stage's meshes, the full mesh first
   std::vector<stage_time> times{};        // wall time of every stage so far, in order
   std::vector<std::vector<double>> welded_saliency{};  // per object: saliency over its welded vertices
                                                        // (saliency stage; the LOD stage reuses it)

@@ -9,19 +9,27 @@
 //     the frame produced, when the demo is built with meshoptimizer;
 //   - DIR/lod.png: the reference shader's images of that view (full mesh on the left, then 35%
 //     and 5%; top row the saliency LOD, bottom row meshoptimizer's), panels of min(W, H, 384)
-//     pixels (at least 16);
-//   - rows lod-full, lod-saliency-35, lod-meshopt-35, lod-saliency-5, lod-meshopt-5 in the
-//     results (summary.csv): seconds = the frame update or the meshopt_simplify call, psnr and
-//     ssim against the full mesh's image of the same view (not against the scene reference),
-//     and the setting names the triangle count, the saliency-weighted mean distance and the
-//     Hausdorff distance to the full mesh (support/surface_distance.hpp).
+//     pixels (at least 16), each labelled with its method, fraction, triangles and PSNR;
+//   - ctx.lod_results (the LOD table and lod.csv of the summary stage): per mesh the triangle
+//     count, the seconds of the frame update or the meshopt_simplify call, the saliency-weighted
+//     mean distance and the Hausdorff distance to the full mesh (support/surface_distance.hpp),
+//     PSNR and SSIM against the full mesh's image of the same view (not the scene reference);
+//   - DIR/lod_orbit.png: six cameras around the mesh (mesh_views' circle of 6), each one's
+//     frame() at 5% with the default options; top row the triangles from that camera, bottom row
+//     the same triangles from the opposite camera. Both rows are headlight-shaded with the edges
+//     of the drawn triangles overlaid (where neighbouring pixels see different triangles), so a
+//     cut that follows the camera shows dense above and coarse below; labels and the printed
+//     lines give each camera's triangle count and the share of them facing it (against the
+//     full mesh's share).
 //
 //   bool stage_lod(demo_context& ctx);
 // Returns false (one line on stderr) when a step fails.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
@@ -30,6 +38,7 @@
 #include <meshoptimizer.h>
 #endif
 #include "demo.hpp"
+#include "draw_label.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
 #include "infolerp/lod/view_dependent_lod.hpp"
 #include "infolerp/lod/weighting_map.hpp"
@@ -47,9 +56,11 @@ namespace detail {
 // One simplified index buffer: its image, the time that made it and its figures.
 struct lod_panel {
   std::string method;
+  double fraction = 1.0;
   std::vector<std::uint32_t> indices;
   double seconds = 0.0;
   support::image img;
+  std::string label;  // drawn into img once every comparison with the full mesh's image is done
 };
 
 // The mesh the LOD stage simplifies: the first object of the first --mesh file, or the built-in torus.
@@ -60,39 +71,67 @@ inline const indexed_mesh& lod_source(const demo_context& ctx) {
   return ctx.scene.objects.back().mesh;
 }
 
-// Renders the panel's view and records its row; false on error (reported).
+// view_dependent_lod's eye for a support camera on a side × side viewport.
+inline lod_camera lod_eye(const support::camera& c, int side) {
+  const auto pixels = static_cast<std::uint32_t>(side);
+  return {glm::dvec3(c.eye), glm::dvec3(c.target - c.eye), glm::dvec3(c.up),
+          static_cast<double>(c.vertical_fov_degrees) * std::numbers::pi / 180.0, pixels, pixels};
+}
+
+// frame() into p.indices for a fraction f of the T triangles: (1 − f)·T/2 contractions, each
+// removing about two triangles. Returns the status of frame() and times it.
+inline status lod_frame(view_dependent_lod& lod, const contraction_hierarchy& h, const lod_camera& eye, std::size_t nt,
+                        lod_panel& p) {
+  const auto budget =
+      std::min<std::uint64_t>(lod.capacity(), static_cast<std::uint64_t>((1.0 - p.fraction) * static_cast<double>(nt) / 2.0));
+  std::vector<index_range> ranges(h.cluster_count);
+  p.indices.resize(contracted_index_bound(h));
+  const auto t0 = std::chrono::steady_clock::now();
+  auto st = lod.frame(eye, budget, p.indices, ranges);
+  p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!st) return st.error();
+  p.indices.resize(st->indices);
+  return {};
+}
+
+// Renders the panel's view, records its figures and its label; false on error (reported).
 inline bool finish_panel(demo_context& ctx, const support::embree_device& device, const indexed_mesh& m,
                          const std::vector<double>& saliency, const support::mesh_view_options& view,
                          lod_panel& p, const support::image* full) {
+  char tag[64];  // e.g. "infolerp 5%", for the time lines
+  std::snprintf(tag, sizeof tag, "%s %g%%", p.method.c_str(), 100.0 * p.fraction);
   const stopwatch render_watch;
   auto imgs = support::render_mesh_views(device, m.positions, p.indices, view);
   if (!imgs) return report(imgs.error()), false;
-  record_time(ctx, "LOD view " + p.method, render_watch.seconds());
+  record_time(ctx, std::string("LOD view ") + tag, render_watch.seconds());
   p.img = std::move((*imgs)[0]);
-  method_result r{p.method, "", p.seconds, std::numeric_limits<double>::infinity(), 1.0, 1.0};
+  lod_result r{p.method, p.fraction, p.indices.size() / 3, p.seconds, 0.0, 0.0, std::numeric_limits<double>::infinity(), 1.0};
   if (full) {
     auto sim = support::compare_views({p.img}, {*full});
     if (!sim) return report(sim.error()), false;
     r.psnr = sim->psnr, r.ssim = sim->ssim;
   }
   const stopwatch metric_watch;
-  progress_line metric_line("LOD metric " + p.method);
+  progress_line metric_line(std::string("LOD metric ") + tag);
   const support::distances d = support::measure(m, saliency, p.indices, with_progress(ctx.options, metric_line));
   metric_line.finish();
-  record_time(ctx, "LOD metric " + p.method, metric_watch.seconds());
-  char line[200];
-  std::snprintf(line, sizeof line, "triangles %zu, weighted distance %.6g, Hausdorff %.6g, PSNR/SSIM against the full mesh's view",
-                p.indices.size() / 3, d.weighted, d.hausdorff);
-  r.setting = line;
-  std::printf("lod: %-16s %7zu triangles, %.6f s, weighted distance %.4g, Hausdorff %.4g, PSNR %.2f dB, SSIM %.4f\n",
-              p.method.c_str(), p.indices.size() / 3, p.seconds, d.weighted, d.hausdorff, r.psnr, r.ssim);
-  ctx.results.push_back(std::move(r));
+  record_time(ctx, std::string("LOD metric ") + tag, metric_watch.seconds());
+  r.weighted_distance = d.weighted, r.hausdorff = d.hausdorff;
+  char text[160];
+  if (full)
+    std::snprintf(text, sizeof text, "%s %g%%\n%zu triangles\nPSNR %.2f dB", p.method.c_str(), 100.0 * p.fraction,
+                  r.triangles, r.psnr);
+  else
+    std::snprintf(text, sizeof text, "full mesh\n%zu triangles", r.triangles);
+  p.label = text;
+  ctx.lod_results.push_back(std::move(r));
   return true;
 }
 
-// Panels placed on a grid of `columns` × 2 (nullptr: left black).
+// Panels placed on a grid of `columns` columns (nullptr: left black).
 inline support::image lod_grid(const std::vector<const support::image*>& cells, int columns, int side) {
-  support::image out(columns * side, 2 * side);
+  const int rows = (static_cast<int>(cells.size()) + columns - 1) / columns;
+  support::image out(columns * side, rows * side);
   for (std::size_t k = 0; k < cells.size(); ++k) {
     if (!cells[k]) continue;
     const int ox = static_cast<int>(k % static_cast<std::size_t>(columns)) * side;
@@ -103,10 +142,88 @@ inline support::image lod_grid(const std::vector<const support::image*>& cells, 
   return out;
 }
 
+// The triangles `tris` (the geometry of `scene`) seen from c on a side × side image: grey
+// shaded by a headlight (0.35 + 0.65·|n·d|, as render_false_colour), sky black, and the edges of
+// the drawn triangles (pixels whose right or lower neighbour sees another triangle) in dark blue.
+inline support::image wireframe_view([[maybe_unused]] const demo_context& ctx, const support::embree_scene& scene,
+                                     std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
+                                     const support::camera& c, int side) {
+  const auto n = static_cast<std::size_t>(side);
+  std::vector<std::uint32_t> id(n * n, invalid_id);
+  support::image img(side, side);
+  const support::pinhole_rays rays = c.rays();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(omp_threads(ctx.options))
+  for (int y = 0; y < side; ++y) {
+    support::enable_flush_to_zero();
+    for (int x = 0; x < side; ++x) {
+      const ray r = rays(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, side, side);
+      const hit h = scene.intersect(r);
+      if (!h.valid()) continue;
+      const glm::uvec3 t = tris[h.triangle];
+      const glm::vec3 nrm = glm::normalize(glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]));
+      img.at(x, y) = glm::vec3(0.8f * (0.35f + 0.65f * std::abs(glm::dot(nrm, r.direction))));
+      id[img.index(x, y)] = h.triangle;
+    }
+  }
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const std::size_t p = img.index(x, y);
+      if ((x + 1 < side && id[p + 1] != id[p]) || (y + 1 < side && id[p + n] != id[p]))
+        img.pixels[p] = {0.02f, 0.06f, 0.35f};
+    }
+  return img;
+}
+
+// The share of the triangles that face the eye (their normal toward it, counter-clockwise).
+inline double facing_share(const indexed_mesh& m, std::span<const glm::uvec3> tris, const glm::vec3& eye) {
+  std::size_t facing = 0;
+  for (const glm::uvec3& t : tris) {
+    const glm::vec3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+    facing += glm::dot(glm::cross(b - a, c - a), eye - a) > 0.0f ? 1 : 0;
+  }
+  return tris.empty() ? 0.0 : static_cast<double>(facing) / static_cast<double>(tris.size());
+}
+
+// DIR/lod_orbit.png: frame() at 5% from six cameras around the mesh (see the prologue).
+inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, view_dependent_lod& lod,
+                      const contraction_hierarchy& h, const indexed_mesh& m, int side) {
+  constexpr unsigned cameras = 6;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<support::image> images(2 * cameras);
+  std::printf("lod_orbit: infolerp 5%% from %u cameras around the mesh\n", cameras);
+  for (unsigned k = 0; k < cameras; ++k) {
+    const support::camera c = support::mesh_view_camera(k, cameras, m.positions);
+    const support::camera behind = support::mesh_view_camera((k + cameras / 2) % cameras, cameras, m.positions);
+    lod_panel p{"infolerp", 0.05, {}, 0.0, {}, {}};
+    if (auto s = lod_frame(lod, h, lod_eye(c, side), m.triangle_count(), p); !s) return report(s), false;
+    std::vector<glm::uvec3> tris(p.indices.size() / 3);
+    for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = {p.indices[3 * t], p.indices[3 * t + 1], p.indices[3 * t + 2]};
+    support::embree_scene scene(device);
+    if (auto id = scene.add_triangles(m.positions, tris); !id) return report(id.error()), false;
+    if (auto s = scene.commit(); !s) return report(s), false;
+    images[k] = wireframe_view(ctx, scene, m.positions, tris, c, side);
+    images[cameras + k] = wireframe_view(ctx, scene, m.positions, tris, behind, side);
+    const double facing = facing_share(m, tris, c.eye), facing_full = facing_share(m, m.triangles, c.eye);
+    char text[200];
+    std::snprintf(text, sizeof text, "camera %u: azimuth %u deg, %s\ninfolerp 5%%: %zu triangles\n%.0f%% face it (full mesh %.0f%%)",
+                  k, 360 * k / cameras, k % 2 == 0 ? "above" : "below", tris.size(), 100.0 * facing, 100.0 * facing_full);
+    draw_label(images[k], 0, 0, text, label_scale(side));
+    std::snprintf(text, sizeof text, "camera %u's triangles\nfrom the opposite side", k);
+    draw_label(images[cameras + k], 0, 0, text, label_scale(side));
+    std::printf("  camera %u: %zu triangles, %.0f%% facing it (full mesh: %.0f%%)\n", k, tris.size(), 100.0 * facing,
+                100.0 * facing_full);
+  }
+  std::vector<const support::image*> cells;
+  for (const auto& img : images) cells.push_back(&img);
+  const support::image grid = lod_grid(cells, cameras, side);
+  std::printf("lod_orbit: %.3f s for the %u frames and %u images\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), cameras, 2 * cameras);
+  return save_png(ctx, grid, "lod_orbit.png");
+}
+
 }  // namespace detail
 
 inline bool stage_lod(demo_context& ctx) {
-  using clk = std::chrono::steady_clock;
   std::vector<std::uint32_t> remap;
   const indexed_mesh& source = detail::lod_source(ctx);
   const indexed_mesh m = support::weld_positions(source, remap);
@@ -152,41 +269,34 @@ inline bool stage_lod(demo_context& ctx) {
   const support::embree_device device;
   const std::size_t nt = m.triangle_count();
   const auto* full_idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
-  detail::lod_panel full{"lod-full", {full_idx, full_idx + 3 * nt}, 0.0, {}};
+  detail::lod_panel full{"full", 1.0, {full_idx, full_idx + 3 * nt}, 0.0, {}, {}};
   if (!detail::finish_panel(ctx, device, m, saliency, view, full, nullptr)) return false;
 
   std::vector<detail::lod_panel> panels;
-  std::vector<index_range> ranges(h->cluster_count);
-  for (const auto& [f, label] : {std::pair{0.35, "35"}, std::pair{0.05, "5"}}) {
-    const auto budget = std::min<std::uint64_t>(lod->capacity(), static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(nt) / 2.0));
-    detail::lod_panel ours{std::string("lod-saliency-") + label, std::vector<std::uint32_t>(contracted_index_bound(*h)), 0.0, {}};
-    const auto t0 = clk::now();
-    const lod_camera eye{glm::dvec3(cam.eye), glm::dvec3(cam.target - cam.eye), glm::dvec3(cam.up),
-                         static_cast<double>(cam.vertical_fov_degrees) * 3.141592653589793 / 180.0, static_cast<std::uint32_t>(side),
-                         static_cast<std::uint32_t>(side)};
-    auto st = lod->frame(eye, budget, ours.indices, ranges);
-    ours.seconds = std::chrono::duration<double>(clk::now() - t0).count();
-    if (!st) return report(st.error()), false;
-    ours.indices.resize(st->indices);
+  for (const double f : {0.35, 0.05}) {
+    detail::lod_panel ours{"infolerp", f, {}, 0.0, {}, {}};
+    if (auto s = detail::lod_frame(*lod, *h, detail::lod_eye(cam, side), nt, ours); !s) return report(s), false;
     if (!detail::finish_panel(ctx, device, m, saliency, view, ours, &full.img)) return false;
-    panels.push_back(std::move(ours));
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
-    detail::lod_panel theirs{std::string("lod-meshopt-") + label, std::vector<std::uint32_t>(3 * nt), 0.0, {}};
-    const auto t1 = clk::now();
+    detail::lod_panel theirs{"meshoptimizer", f, std::vector<std::uint32_t>(3 * nt), 0.0, {}, {}};
+    const auto t1 = std::chrono::steady_clock::now();
     const std::size_t k = meshopt_simplify(theirs.indices.data(), full_idx, 3 * nt, &m.positions[0].x, m.vertex_count(),
-                                           sizeof(glm::vec3), st->indices, std::numeric_limits<float>::max(), 0, nullptr);
-    theirs.seconds = std::chrono::duration<double>(clk::now() - t1).count();
+                                           sizeof(glm::vec3), ours.indices.size(), std::numeric_limits<float>::max(), 0, nullptr);
+    theirs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     theirs.indices.resize(k);
     if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
-    panels.push_back(std::move(theirs));
 #else
-    panels.push_back({});
+    detail::lod_panel theirs;
 #endif
+    panels.push_back(std::move(ours));
+    panels.push_back(std::move(theirs));
   }
+  for (auto* p : {&full, &panels[0], &panels[1], &panels[2], &panels[3]})
+    if (!p->img.pixels.empty()) draw_label(p->img, 0, 0, p->label, label_scale(side));
   // Grid: full | 35% | 5%, saliency LOD on top, meshoptimizer below.
   const auto cell = [&](std::size_t k) { return panels[k].indices.empty() ? nullptr : &panels[k].img; };
   const support::image grid = detail::lod_grid({&full.img, cell(0), cell(2), &full.img, cell(1), cell(3)}, 3, side);
-  return save_png(ctx, grid, "lod.png");
+  return save_png(ctx, grid, "lod.png") && detail::lod_orbit(ctx, device, *lod, *h, m, side);
 }
 
 }  // namespace infolerp::demo

@@ -52,6 +52,7 @@
 #include "infolerp/lod/screen_error_selection.hpp"
 #include "infolerp/lod/vertex_contraction.hpp"
 #include "infolerp/lod/cluster_split.hpp"
+#include "infolerp/lod/cluster_local_indices.hpp"
 #include "infolerp/mesh/support_function.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/random.hpp"

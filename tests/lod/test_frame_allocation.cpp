@@ -1,7 +1,9 @@
-// The per-frame entry point allocates nothing after setup (view_dependent_lod.hpp): counted by
-// replacing the global operator new in this test executable.
+// The per-frame entry point and its 16-bit conversion allocate nothing after setup
+// (view_dependent_lod.hpp, cluster_local_indices.hpp): counted by replacing the global operator
+// new in this test executable.
 #include <vector>
 #include <catch2/catch.hpp>
+#include "infolerp/lod/cluster_local_indices.hpp"
 #include "infolerp/lod/view_dependent_lod.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/procedural.hpp"
@@ -21,14 +23,22 @@ TEST_CASE("a frame allocates nothing after setup", "[lod]") {
   auto paper = view_dependent_lod::create(*h, *table, {.selection = lod_selection::paper, .view = {}});
   REQUIRE(lod.ok());
   REQUIRE(paper.ok());
+  auto local = make_local_index_table(m, *h, 120);  // several parts per cluster
+  REQUIRE(local.ok());
+  REQUIRE(local->part_count() > 5);
   std::vector<std::uint32_t> out(contracted_index_bound(*h));
-  std::vector<index_range> ranges(5);
+  std::vector<std::uint16_t> out16(out.size());
+  std::vector<index_range> ranges(5), parts(local->part_count());
   const lod_camera camera{{0.2, 3.0, 1.0}, {-0.2, -3.0, -1.0}, {0.0, 0.0, 1.0}, 0.8, 640, 480};
+  const auto localized_all = [&](const result<lod_frame_stats>& st) {
+    auto n = localize_indices(*local, out, ranges, out16, parts);
+    return st.ok() && n.ok() && *n == st->indices;
+  };
   const std::size_t before = support::heap_allocations.load();
   bool ok = true;
   for (std::uint64_t r : {std::uint64_t{10}, std::uint64_t{h->local_contractions}, lod->capacity() - 1}) {
-    ok = ok && lod->frame(camera, r, out, ranges).ok();
-    ok = ok && paper->frame(camera, r, out, ranges).ok();
+    ok = ok && localized_all(lod->frame(camera, r, out, ranges));
+    ok = ok && localized_all(paper->frame(camera, r, out, ranges));
   }
   const std::size_t during = support::heap_allocations.load() - before;
   REQUIRE(ok);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <glm/common.hpp>
 #include "support/image.hpp"
 
@@ -15,18 +16,38 @@ namespace infolerp::support {
 
 namespace {
 
-// The next level: every texel the mean of the (up to) 2x2 texels above it.
+// The source texels under each of the n texels that replace m (n = max(1, m / 2)) and their
+// shares of it: texel j of m covers [j n, (j + 1) n) and texel i of n covers [i m, (i + 1) m) in
+// units of 1 / (m n), so every source texel counts by its exact overlap, an odd size's last row
+// or column included (a 2x2 box for even sizes).
+struct tap {
+  int j;
+  float w;
+};
+std::vector<std::vector<tap>> box_taps(int m, int n) {
+  std::vector<std::vector<tap>> taps(static_cast<std::size_t>(n));
+  const auto mm = static_cast<std::size_t>(m), nn = static_cast<std::size_t>(n);
+  for (std::size_t i = 0; i < nn; ++i)
+    for (std::size_t j = i * mm / nn; j * nn < (i + 1) * mm; ++j) {
+      const std::size_t overlap = std::min((i + 1) * mm, (j + 1) * nn) - std::max(i * mm, j * nn);
+      taps[i].push_back({static_cast<int>(j), static_cast<float>(overlap) / static_cast<float>(mm)});
+    }
+  return taps;
+}
+
+// The next level: every texel the area-weighted mean of the texels above it.
 texture_level halve(const texture_level& a) {
   texture_level b;
   b.width = std::max(1, a.width / 2);
   b.height = std::max(1, a.height / 2);
   b.texels.resize(static_cast<std::size_t>(b.width) * static_cast<std::size_t>(b.height));
+  const auto xs = box_taps(a.width, b.width), ys = box_taps(a.height, b.height);
   for (int y = 0; y < b.height; ++y)
     for (int x = 0; x < b.width; ++x) {
-      const int x0 = std::min(2 * x, a.width - 1), x1 = std::min(2 * x + 1, a.width - 1);
-      const int y0 = std::min(2 * y, a.height - 1), y1 = std::min(2 * y + 1, a.height - 1);
-      b.texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(b.width) + static_cast<std::size_t>(x)] =
-          0.25f * (a.at(x0, y0) + a.at(x1, y0) + a.at(x0, y1) + a.at(x1, y1));
+      glm::vec3 sum(0.0f);
+      for (const tap& ty : ys[static_cast<std::size_t>(y)])
+        for (const tap& tx : xs[static_cast<std::size_t>(x)]) sum += ty.w * tx.w * a.at(tx.j, ty.j);
+      b.texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(b.width) + static_cast<std::size_t>(x)] = sum;
     }
   return b;
 }
@@ -34,6 +55,13 @@ texture_level halve(const texture_level& a) {
 int wrap(int i, int n) {
   const int m = i % n;
   return m < 0 ? m + n : m;
+}
+
+// An image of w x h texels that texture::create accepts, checked before it is decoded.
+status check_size(int w, int h, const std::string& name) {
+  if (w > 0 && h > 0 && static_cast<std::size_t>(w) * static_cast<std::size_t>(h) <= texture::max_texels) return {};
+  return make_error(errc::bad_size, no_element, "texture '", name, "' is ", w, "x", h, " texels (at most ", texture::max_texels,
+                    " texels)");
 }
 
 result<texture> from_stb(unsigned char* data, int w, int h, const std::string& name) {
@@ -49,7 +77,8 @@ result<texture> from_stb(unsigned char* data, int w, int h, const std::string& n
 }  // namespace
 
 result<texture> texture::create(int width, int height, std::vector<glm::vec3> texels) {
-  if (width <= 0 || height <= 0 || texels.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+  if (auto s = check_size(width, height, "(in memory)"); !s) return s;
+  if (texels.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
     return make_error(errc::bad_size, no_element, "texture: ", width, "x", height, " with ", texels.size(), " texels");
   texture t;
   t.levels_.push_back({width, height, std::move(texels)});
@@ -58,6 +87,7 @@ result<texture> texture::create(int width, int height, std::vector<glm::vec3> te
 }
 
 glm::vec3 texture::bilinear(glm::vec2 uv, std::size_t k) const {
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
   const texture_level& l = levels_[std::min(k, levels_.size() - 1)];
   // Texel centres at (i + 0.5) / width; v = 0 is the bottom row.
   const float fx = (uv.x - std::floor(uv.x)) * static_cast<float>(l.width) - 0.5f;
@@ -80,13 +110,20 @@ glm::vec3 texture::trilinear(glm::vec2 uv, float lod) const {
 
 result<texture> load_texture(const std::string& path) {
   int w = 0, h = 0, n = 0;
+  if (stbi_info(path.c_str(), &w, &h, &n) != 0)
+    if (auto s = check_size(w, h, path); !s) return s;
   unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);  // before w and h are read
   return from_stb(data, w, h, path);
 }
 
 result<texture> decode_texture(std::span<const unsigned char> bytes, const std::string& name) {
+  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    return make_error(errc::bad_size, no_element, "texture '", name, "' is ", bytes.size(), " bytes (at most 2^31 - 1)");
   int w = 0, h = 0, n = 0;
-  unsigned char* data = stbi_load_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &n, 3);
+  const auto size = static_cast<int>(bytes.size());
+  if (stbi_info_from_memory(bytes.data(), size, &w, &h, &n) != 0)
+    if (auto s = check_size(w, h, name); !s) return s;
+  unsigned char* data = stbi_load_from_memory(bytes.data(), size, &w, &h, &n, 3);
   return from_stb(data, w, h, name);
 }
 

@@ -24,8 +24,10 @@ struct texture_level {
 
 class texture {
  public:
+  static constexpr std::size_t max_texels = std::size_t{1} << 26;  // 8192 x 8192: level 0 768 MiB
+
   // The image (linear RGB, width x height texels, row 0 on top) and its mip chain.
-  // Errors: a non-positive size or texels.size() != width * height (bad_size).
+  // Errors: a non-positive size, more than max_texels or texels.size() != width * height (bad_size).
   static result<texture> create(int width, int height, std::vector<glm::vec3> texels);
 
   int width() const { return levels_.front().width; }
@@ -44,7 +46,7 @@ class texture {
 };
 
 // Reads an image file. Errors: unreadable or undecodable file (the message names it and gives
-// stb_image's reason).
+// stb_image's reason), an image above max_texels (bad_size, before it is decoded).
 result<texture> load_texture(const std::string& path);
 // Decodes an image held in memory (a compressed PNG/JPEG/...); name is for the error message.
 result<texture> decode_texture(std::span<const unsigned char> bytes, const std::string& name);

@@ -4,9 +4,11 @@
 // be easily enforced during pre-processing").
 // Each cluster's triangles are visited along a Morton curve of their centroids and cut into
 // consecutive parts whenever the next triangle would bring the part above max_vertices distinct
-// vertices, so every part is spatially compact and at most max_vertices vertices large. A cluster
-// within the limit keeps one id. New ids: the parts of cluster 0 first, then those of cluster 1,
-// and so on (an empty cluster gets none); first_part[c] is the first id of cluster c. Deterministic.
+// vertices (one limit for all clusters, or one per cluster: cluster_local_indices.hpp cuts again
+// only the clusters whose parts overflow), so every part is spatially compact and at most its
+// limit large. A cluster within its limit keeps one id. New ids: the parts of cluster 0 first,
+// then those of cluster 1, and so on (an empty cluster gets none); first_part[c] is the first id
+// of cluster c. Deterministic.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -26,12 +28,15 @@ struct split_clusters_result {
 };
 
 // Errors: mesh errors (empty, index out of range, non-finite position), cluster.size() != T
-// (bad_size), a cluster id >= cluster_count (names the triangle), max_vertices < 3
-// (bad_parameter). Complexity O(T log T); allocation O(V + T).
+// (bad_size), a cluster id >= cluster_count (names the triangle), a limit < 3 (bad_parameter),
+// max_vertices not one per cluster (bad_size). Complexity O(T log T); allocation O(V + T).
 template <class M>
 result<split_clusters_result> split_clusters(const M& m, std::span<const std::uint32_t> cluster,
-                                             std::uint32_t cluster_count, std::uint32_t max_vertices = 65536) {
+                                             std::uint32_t cluster_count, std::span<const std::uint32_t> max_vertices) {
   static_assert(check_mesh<M>());
+  if (max_vertices.size() != cluster_count)
+    return make_error(errc::bad_size, max_vertices.size(), "max_vertices has ", max_vertices.size(), " limits for ",
+                      cluster_count, " clusters");
   if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
   const std::size_t nt = mesh_triangle_count(m), nv = mesh_vertex_count(m);
   if (cluster.size() != nt)
@@ -40,8 +45,9 @@ result<split_clusters_result> split_clusters(const M& m, std::span<const std::ui
     if (cluster[t] >= cluster_count)
       return make_error(errc::index_out_of_range, t, "triangle ", t, ": cluster ", cluster[t], " >= cluster count ",
                         cluster_count);
-  if (max_vertices < 3)
-    return make_error(errc::bad_parameter, no_element, "max_vertices ", max_vertices, " must be at least 3");
+  for (std::uint32_t c = 0; c < cluster_count; ++c)
+    if (max_vertices[c] < 3)
+      return make_error(errc::bad_parameter, c, "cluster ", c, ": max_vertices ", max_vertices[c], " must be at least 3");
   // Triangles grouped by cluster, Morton order inside each (a stable counting sort of the curve).
   const std::vector<std::uint32_t> curve = morton_triangle_order(m);
   std::vector<std::uint32_t> offsets, grouped;
@@ -66,7 +72,7 @@ result<split_clusters_result> split_clusters(const M& m, std::span<const std::ui
         for (int i = 0; i < j; ++i) dup = dup || f[i] == f[j];
         fresh += dup ? 0u : 1u;
       }
-      if (size + fresh > max_vertices) {  // close this part, start the next with this triangle
+      if (size + fresh > max_vertices[c]) {  // close this part, start the next with this triangle
         ++part;
         size = 0;
         fresh = 0;
@@ -85,6 +91,14 @@ result<split_clusters_result> split_clusters(const M& m, std::span<const std::ui
   out.first_part[cluster_count] = part;
   out.count = part;
   return out;
+}
+
+// One limit for every cluster.
+template <class M>
+result<split_clusters_result> split_clusters(const M& m, std::span<const std::uint32_t> cluster,
+                                             std::uint32_t cluster_count, std::uint32_t max_vertices = 65536) {
+  const std::vector<std::uint32_t> limits(cluster_count, max_vertices);
+  return split_clusters(m, cluster, cluster_count, std::span<const std::uint32_t>(limits));
 }
 
 }  // namespace infolerp
