@@ -1,6 +1,6 @@
 // The demo's own measures and scene set-up (tests/support): the LOD stage's surface distance
 // and distances against brute-force minima over every triangle; asset groups keeping their
-// relative placement, the up axis, and the note of an undefined OBJ material.
+// relative placement, and the up axis.
 #include <catch2/catch.hpp>
 
 #include <cstdint>
@@ -193,18 +193,4 @@ TEST_CASE("--up: a Y-up file is turned to the scene's Z-up, a Z-up file stays up
   CHECK(f.y == Approx(4.0));
   CHECK(f.z == Approx(2.0));
   CHECK(mesh_bounds(object_named(*z_up, tower).mesh).lo.z == Approx(0.0).margin(1e-6));  // on the ground
-}
-
-TEST_CASE("a usemtl naming a material the MTL does not define says so in the part's note", "[demo][scene]") {
-  const scratch_dir dir("material");
-  std::ofstream(dir.path / "a.mtl") << "newmtl red\nKd 1 0 0\n";
-  std::ofstream(dir.path / "a.obj") << "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n"
-                                       "usemtl red\nf 1/1 2/2 3/3\nusemtl ghost\nf 2/2 4/4 3/3\n";
-  const std::string path = (dir.path / "a.obj").string();
-  auto scene = support::make_demo_scene(demo_device(), {.mesh_paths = {path}});
-  REQUIRE(scene);
-  const std::string& ghost = object_named(*scene, path + " [ghost]").note;
-  CHECK(ghost.find("'ghost'") != std::string::npos);
-  CHECK(ghost.find("not defined") != std::string::npos);
-  CHECK(object_named(*scene, path + " [red]").note.find("not defined") == std::string::npos);
 }

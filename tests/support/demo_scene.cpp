@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <map>
-#include <set>
 #include <string_view>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -149,35 +146,6 @@ result<std::vector<textured_part>> load_parts(const std::string& path) {
   return parts;
 }
 
-// The material names an OBJ file's usemtl lines use that none of its mtllib files defines
-// with newmtl (assimp then makes a default material of that name). Unreadable MTL files define
-// nothing. O(file size).
-std::vector<std::string> undefined_obj_materials(const std::string& path) {
-  std::ifstream in(path);
-  std::set<std::string> used, defined;
-  std::vector<std::string> libraries;
-  const auto rest = [](const std::string& line, std::size_t from) {
-    const auto b = line.find_first_not_of(" \t", from), e = line.find_last_not_of(" \t\r");
-    return b == std::string::npos ? std::string() : line.substr(b, e + 1 - b);
-  };
-  for (std::string line; std::getline(in, line);) {
-    if (line.starts_with("usemtl ") || line.starts_with("usemtl\t")) used.insert(rest(line, 6));
-    else if (line.starts_with("mtllib ") || line.starts_with("mtllib\t")) libraries.push_back(rest(line, 6));
-  }
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  for (const auto& library : libraries) {
-    std::ifstream mtl(dir / library);
-    for (std::string line; std::getline(mtl, line);) {
-      line = rest(line, 0);
-      if (line.starts_with("newmtl ") || line.starts_with("newmtl\t")) defined.insert(rest(line, 6));
-    }
-  }
-  std::vector<std::string> out;
-  for (const auto& name : used)
-    if (!defined.contains(name)) out.push_back(name);
-  return out;
-}
-
 // One part of an asset group with the file it came from.
 struct loaded_part {
   std::string path;
@@ -188,8 +156,7 @@ struct loaded_part {
 // turns them Z-up (a Y-up file is rotated +90° about X; Z-up files stay as they are), scales the
 // whole group so that its largest extent is `size` and stands it on the ground at `where` (x,
 // y): the files keep their relative placement and scale. One object per part. Normals the file
-// lacks are area-weighted vertex normals; the file's are turned with it. A part whose OBJ
-// material is not defined in the MTL says so in its note.
+// lacks are area-weighted vertex normals; the file's are turned with it.
 result<std::vector<scene_object>> load_fitted_group(const std::vector<std::string>& paths, bool z_up, float size,
                                                     glm::vec2 where) {
   const glm::mat4 up = z_up ? glm::mat4(1.0f) : glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f));
@@ -198,12 +165,9 @@ result<std::vector<scene_object>> load_fitted_group(const std::vector<std::strin
   for (const auto& path : paths) {
     auto loaded = load_parts(path);
     if (!loaded) return loaded.error();
-    const auto undefined = path.ends_with(".obj") || path.ends_with(".OBJ") ? undefined_obj_materials(path) : std::vector<std::string>{};
     for (auto& part : *loaded) {
       part.mesh = moved(part.mesh, up);
       append(all, part.mesh);
-      if (std::find(undefined.begin(), undefined.end(), part.material) != undefined.end())
-        part.note = "material '" + part.material + "' is not defined in the MTL file" + (part.note.empty() ? "" : "; " + part.note);
       parts.push_back({path, std::move(part)});
     }
   }
