@@ -53,6 +53,8 @@ if(MODE STREQUAL "errors")
   expect_error(2 "--threshold: orientation value 'nan'" --threshold orientation=nan)
   expect_error(2 "--threshold needs CHANNEL=VALUE" --threshold visibility)
   expect_error(2 "--mesh needs a file name" --mesh)
+  expect_error(2 "--group needs a name" --group)
+  expect_error(2 "--up needs y or z" --up x)
 
   # Files: missing, not a mesh, truncated, counts the file cannot hold, an index out of range, a
   # NaN coordinate.
@@ -103,6 +105,15 @@ elseif(MODE STREQUAL "run")
      OR "${rows}" MATCHES "(^|;)lod-")
     message(FATAL_ERROR "summary.csv:\n${rows}")
   endif()
+  foreach(stage IN ITEMS "load" "BVH" "reference" "clustering: visibility channel" "saliency" "LOD salient clustering"
+                         "LOD metric infolerp 5%" "I-Buffer row ibuffer-3")
+    if(NOT out MATCHES "\ntime: ${stage}[^\n]* [0-9.]+ s\n")
+      message(FATAL_ERROR "the demo did not print the time of stage '${stage}':\n${out}")
+    endif()
+  endforeach()
+  if(NOT out MATCHES "where the time went")
+    message(FATAL_ERROR "no closing list of stage times:\n${out}")
+  endif()
   # The LOD figures: their own table and lod.csv, the full mesh first, then each method at 35% and 5%.
   file(STRINGS ${WORK_DIR}/out/lod.csv rows)
   set(number "[0-9.e+-]+")
@@ -149,5 +160,11 @@ elseif(MODE STREQUAL "run")
   if(NOT rc EQUAL 0 OR NOT out MATCHES "scene: 6 objects" OR NOT out MATCHES "quad.obj[^\n]*no diffuse texture"
      OR NOT out MATCHES "quad.off[^\n]*no texcoords: stretch channel skipped")
     message(FATAL_ERROR "two --mesh: exit '${rc}'\n${out}\n${err}")
+  endif()
+  # The same two files as one Z-up group.
+  execute_process(COMMAND ${DEMO} --size 33 33 --ao 2 --soft 1 --up z --group pair --mesh ${WORK_DIR}/quad.obj
+                          --mesh ${WORK_DIR}/quad.off --out ${WORK_DIR}/group RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "scene: 6 objects")
+    message(FATAL_ERROR "--group: exit '${rc}'\n${out}\n${err}")
   endif()
 endif()

@@ -2,19 +2,30 @@
 // What the demo's stages share. main.cpp parses the options, builds the scene and renders the
 // per-pixel reference; later stages (clusters, saliency, upsampler) are functions taking a
 // demo_context, declared in examples/demo/stage_<name>.hpp and called from main.cpp in order.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 #include <glm/geometric.hpp>
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#endif
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#include "infolerp/core/executor.hpp"
 #include "support/demo_scene.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
@@ -30,6 +41,8 @@ struct demo_options {
   int threads = 0;                   // --threads N (0 = all cores); every stage uses this many
   std::filesystem::path out_dir = "infolerp-out";  // --out DIR
   std::vector<std::string> mesh_paths;  // --mesh FILE, repeatable (none: built-in scene only)
+  std::vector<std::string> mesh_groups;  // per mesh path: the --group NAME before it ("" when none)
+  bool z_up = false;                 // --up z: the assets are Z-up (default y: Y-up)
   support::shader_options shader;    // --ao N, --soft N
   std::uint32_t passes = 4;          // --passes K: I-Buffer passes of ibuffer.png; 0 = auto (pass controller)
   std::map<std::string, float> thresholds;  // --threshold CHANNEL=VALUE: channel (visibility,
@@ -44,6 +57,12 @@ struct method_result {
   double psnr = 0.0;         // dB against the reference (+inf when identical)
   double ssim = 1.0;         // mean SSIM of the display luma (NaN for images below 11x11)
   double evaluated = 1.0;    // fully evaluated samples per pixel
+};
+
+// Wall time of one stage (printed as it ends, listed again at the end of the run).
+struct stage_time {
+  std::string stage;
+  double seconds = 0.0;
 };
 
 // One simplified mesh of the LOD stage, for the LOD table and lod.csv.
@@ -65,6 +84,9 @@ struct demo_context {
   support::render_stats reference_stats;  // its time and ray count
   std::vector<method_result> results;     // every method run so far, the reference first
   std::vector<lod_result> lod_results{};  // the LOD stage's meshes, the full mesh first
+  std::vector<stage_time> times{};        // wall time of every stage so far, in order
+  std::vector<std::vector<double>> welded_saliency{};  // per object: saliency over its welded vertices
+                                                       // (saliency stage; the LOD stage reuses it)
 };
 
 // Display luma of every pixel (what SSIM compares).
@@ -95,26 +117,141 @@ inline int omp_threads(const demo_options& o) {
 #endif
 }
 
-// A one-line progress bar on stderr: call with (done, total); prints only when the
-// bar grows and ends the line at 100%. Not thread-safe (callers serialise).
-class progress_bar {
+// Progress of a long stage on stderr, quiet for its first two seconds: then on a terminal one
+// line rewritten in place ('\r', at most four times a second), otherwise a line at each 10%
+// step (at most one a second; every 10 s for elapsed()). Call it with (done, total) from any
+// thread (a mutex, try-locked, so no caller waits for another's print), or elapsed() where no
+// fraction is known; finish() ends the line. `loop` > 0 names which of a stage's parallel
+// loops the figure is for (see progress_executor).
+class progress_line {
  public:
-  explicit progress_bar(std::string label) : label_(std::move(label)) {}
-  void operator()(int done, int total) {
-    const int percent = total > 0 ? 100 * done / total : 100;
-    const int filled = percent / 2;
-    if (filled == last_) return;  // at most 51 updates
-    last_ = filled;
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_.c_str(), filled, "##################################################",
-                 50 - filled, "", percent);
-    if (percent == 100) std::fputc('\n', stderr);
-    std::fflush(stderr);
+  using clock = std::chrono::steady_clock;
+  explicit progress_line(std::string label) : label_(std::move(label)) {}
+  progress_line(const progress_line&) = delete;
+  progress_line& operator=(const progress_line&) = delete;
+  ~progress_line() { finish(); }
+
+  void operator()(std::size_t done, std::size_t total, unsigned loop = 0) {
+    const int percent = total > 0 ? static_cast<int>(100 * std::min(done, total) / total) : 100;
+    char text[64];
+    std::snprintf(text, sizeof text, loop > 0 ? "%3d%% (parallel loop %u)" : "%3d%%", percent, loop);
+    print(static_cast<unsigned long long>(percent / 10) + 11ull * loop, std::chrono::seconds(1), text);  // a new loop is a new step
+  }
+  void elapsed() {
+    const auto tens = std::chrono::duration_cast<std::chrono::seconds>(clock::now() - start_).count() / 10;
+    print(static_cast<unsigned long long>(tens), std::chrono::seconds(0), "running");
+  }
+  void finish() {
+    const std::lock_guard lock(mutex_);
+    if (wrote_) std::fputc('\n', stderr);
+    wrote_ = false;
   }
 
  private:
   std::string label_;
-  int last_ = -1;
+  clock::time_point start_ = clock::now(), last_{};
+  std::mutex mutex_;
+  bool tty_ = stderr_is_terminal();
+  bool wrote_ = false;  // a terminal line is open
+  unsigned long long step_ = ~0ull;
+
+  // Prints "LABEL: TEXT, S s" when due: after 2 s, then on a terminal every quarter second,
+  // otherwise when `step` changes and `gap` has passed since the last line.
+  void print(unsigned long long step, clock::duration gap, const char* text) {
+    const auto now = clock::now();
+    if (now - start_ < std::chrono::seconds(2)) return;
+    const std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return;
+    if (tty_ ? now - last_ < std::chrono::milliseconds(250) : step == step_ || now - last_ < gap) return;
+    last_ = now, step_ = step;
+    std::fprintf(stderr, "%s%s: %s, %.1f s%s", tty_ ? "\r" : "", label_.c_str(), text,
+                 std::chrono::duration<double>(now - start_).count(), tty_ ? "   " : "\n");
+    std::fflush(stderr);
+    wrote_ = tty_;
+  }
+  static bool stderr_is_terminal() {
+#if __has_include(<unistd.h>)
+    return isatty(2) != 0;
+#else
+    return false;
+#endif
+  }
 };
+
+// For a stage that reports nothing (a serial library call): a thread that shows the elapsed
+// time on `line` four times a second until the heartbeat is destroyed.
+class heartbeat {
+ public:
+  explicit heartbeat(progress_line& line)
+      : thread_([this, &line] {
+          std::unique_lock lock(mutex_);
+          while (!stopped_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stop_; })) line.elapsed();
+        }) {}
+  heartbeat(const heartbeat&) = delete;
+  heartbeat& operator=(const heartbeat&) = delete;
+  ~heartbeat() {
+    {
+      const std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    stopped_.notify_one();
+    thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable stopped_;
+  bool stop_ = false;
+  std::thread thread_;  // last: starts once the members it uses exist
+};
+
+// An executor that runs on E and reports each finished range to a progress_line: what a
+// stage's library calls do shows without the library printing anything. Each parallel_for is
+// one loop (numbered from 1); done counts its finished elements. The cost is one atomic add
+// and one clock read per range.
+template <class E>
+struct progress_executor {
+  E inner;
+  progress_line* line;
+  std::shared_ptr<std::atomic<unsigned>> loops = std::make_shared<std::atomic<unsigned>>(0);
+
+  template <class F>
+  void parallel_for(std::size_t n, std::size_t grain, F&& fn) const {
+    const unsigned loop = ++*loops;
+    std::atomic<std::size_t> done{0};
+    inner.parallel_for(n, grain, [&](std::size_t b, std::size_t e) {
+      fn(b, e);
+      (*line)(done.fetch_add(e - b) + (e - b), n, loop);
+    });
+  }
+};
+
+// The executor every stage uses: OpenMP over --threads workers when built with OpenMP.
+#ifdef _OPENMP
+using stage_executor = openmp_executor;
+inline stage_executor make_executor(const demo_options& o) { return openmp_executor{o.threads}; }
+#else
+using stage_executor = serial_executor;
+inline stage_executor make_executor(const demo_options&) { return {}; }
+#endif
+
+// The stage executor reporting to `line`.
+inline progress_executor<stage_executor> with_progress(const demo_options& o, progress_line& line) {
+  return {make_executor(o), &line};
+}
+
+// Wall time since construction (steady clock).
+struct stopwatch {
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+};
+
+// Prints a stage's wall time ("time: STAGE  S s") and keeps it for the closing list.
+inline void record_time(demo_context& ctx, std::string stage, double seconds) {
+  std::printf("time: %-40s %9.3f s\n", stage.c_str(), seconds);
+  std::fflush(stdout);
+  ctx.times.push_back({std::move(stage), seconds});
+}
 
 // One line on stderr for a failed status (without the library's "infolerp: " prefix).
 inline void report(const status& s) {

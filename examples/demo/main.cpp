@@ -2,8 +2,11 @@
 // per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
 // saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), the
 // view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,
-// tradeoff.png). Any error gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an unreadable or malformed mesh,
-// an unwritable output directory).
+// tradeoff.png). Every stage prints its wall time ("time: STAGE  S s") and the run ends with
+// the list of stages, longest first; a stage past about 2 s shows progress on stderr. Any error
+// gives one line on stderr and a non-zero exit: 2 for a bad option, 1 for anything else (an
+// unreadable or malformed mesh, an unwritable output directory).
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +15,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 #include "demo.hpp"
 #include "stage_clusters.hpp"
 #include "stage_lod.hpp"
@@ -27,7 +31,11 @@ namespace {
 constexpr const char* usage =
     "usage: infolerp_demo [options]\n"
     "  --mesh FILE     add an asset to the built-in scene (repeatable): OBJ+MTL, glTF/GLB, PLY, OFF\n"
-    "                  (via assimp); one object per material, shaded with its diffuse texture\n"
+    "                  (via assimp); one object per material, shaded with its diffuse texture;\n"
+    "                  each file (or group) is scaled to the same size and placed in a row\n"
+    "  --group NAME    the --mesh files after this, up to the next --group, belong together: they\n"
+    "                  keep their relative placement and scale (e.g. a car body and its wheels)\n"
+    "  --up y|z        the assets' up axis (default y; z for Z-up files, as many game assets)\n"
     "  --size W H      image size in pixels (default 1025 1025)\n"
     "  --passes K|auto I-Buffer passes of ibuffer.png (1-16, default 4); auto: the pass controller\n"
     "                  (frame-time bounds 1/60-1/30 s, at most 4 passes)\n"
@@ -68,6 +76,7 @@ bool parse_int(std::string_view text, int lo, int hi, int& out) {
 // Parses argv; on error prints one line and returns nothing. --help prints usage and exits 0.
 std::optional<demo::demo_options> parse_options(int argc, char** argv) {
   demo::demo_options o;
+  std::string group;  // the current --group ("" before the first)
   auto fail = [](const std::string& message) {
     std::fprintf(stderr, "infolerp_demo: %s (try --help)\n", message.c_str());
     return std::nullopt;
@@ -87,6 +96,14 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
     } else if (arg == "--mesh") {
       if (!need(1)) return fail("--mesh needs a file name");
       o.mesh_paths.emplace_back(argv[++i]);
+      o.mesh_groups.push_back(group);
+    } else if (arg == "--group") {
+      if (!need(1)) return fail("--group needs a name");
+      group = argv[++i];
+    } else if (arg == "--up") {
+      if (!need(1) || (std::string_view(argv[i + 1]) != "y" && std::string_view(argv[i + 1]) != "z"))
+        return fail("--up needs y or z");
+      o.z_up = std::string_view(argv[++i]) == "z";
     } else if (arg == "--size") {
       if (!need(2) || !parse_int(argv[i + 1], 1, 16384, o.width) || !parse_int(argv[i + 2], 1, 16384, o.height))
         return fail("--size needs two integers W H in [1, 16384]");
@@ -128,13 +145,16 @@ bool stage_reference(demo::demo_context& ctx) {
   const auto& o = ctx.options;
   std::printf("reference: %dx%d, AO %u rays, soft shadow %u rays, hard-shadow sun, textures, %s\n", o.width,
               o.height, o.shader.ao_rays, o.shader.soft_shadow_rays, o.shader.packets ? "16-ray packets" : "single rays");
-  demo::progress_bar bar("reference");
-  auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads, std::ref(bar));
+  demo::progress_line line("reference");
+  auto stats = support::render_reference(ctx.shader, o.width, o.height, ctx.reference, o.threads,
+                                         [&](int done, int total) { line(static_cast<std::size_t>(done), static_cast<std::size_t>(total)); });
+  line.finish();
   if (!stats) {
     demo::report(stats.error());
     return false;
   }
   ctx.reference_stats = *stats;
+  demo::record_time(ctx, "reference", stats->seconds);
   std::printf("reference: %.3f s, %llu rays, %.2f Mrays/s\n", stats->seconds,
               static_cast<unsigned long long>(stats->rays), stats->rays_per_second() * 1e-6);
   demo::add_result(ctx, "reference",
@@ -144,9 +164,21 @@ bool stage_reference(demo::demo_context& ctx) {
   return demo::save_png(ctx, ctx.reference, "reference.png");
 }
 
+// The closing list of stage times, longest first, each with its share of the whole run.
+void print_times(const demo::demo_context& ctx, double total) {
+  std::vector<demo::stage_time> times = ctx.times;
+  double listed = 0.0;
+  for (const auto& t : times) listed += t.seconds;
+  times.push_back({"the rest (start-up, images, LOD frames, orbit)", total - listed});
+  std::stable_sort(times.begin(), times.end(), [](const auto& a, const auto& b) { return a.seconds > b.seconds; });
+  std::printf("where the time went (%.3f s in all):\n", total);
+  for (const auto& t : times) std::printf("  %-40s %9.3f s  %5.1f%%\n", t.stage.c_str(), t.seconds, 100.0 * t.seconds / total);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  const demo::stopwatch run;
   const auto options = parse_options(argc, argv);
   if (!options) return 2;
   std::error_code ec;
@@ -160,7 +192,7 @@ int main(int argc, char** argv) {
   support::enable_flush_to_zero();
   const std::string embree_config = options->threads > 0 ? "threads=" + std::to_string(options->threads) : "";
   const support::embree_device device(embree_config.c_str());
-  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths});
+  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths, .mesh_groups = options->mesh_groups, .z_up = options->z_up});
   if (!scene) {
     demo::report(scene.error());
     return 1;
@@ -185,7 +217,9 @@ int main(int argc, char** argv) {
     for (const auto& [channel, value] : options->thresholds) std::printf(" %s=%g", channel.c_str(), static_cast<double>(value));
     std::printf(" (for the clusters stage)\n");
   }
-  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}};
+  demo::demo_context ctx{*options, *scene, shader, {}, {}, {}, {}, {}};
+  demo::record_time(ctx, "load", scene->load_seconds);
+  demo::record_time(ctx, "BVH", scene->bvh_seconds);
   if (!stage_reference(ctx)) return 1;
   support::scene_clustering clusters;
   if (!demo::stage_clusters(ctx, clusters)) return 1;
@@ -193,5 +227,6 @@ int main(int argc, char** argv) {
   if (!demo::stage_upsample(ctx, &clusters)) return 1;
   if (!demo::stage_lod(ctx)) return 1;
   if (!demo::stage_summary(ctx)) return 1;
+  print_times(ctx, run.seconds());
   return 0;
 }

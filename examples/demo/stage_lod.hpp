@@ -30,6 +30,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -97,8 +98,12 @@ inline status lod_frame(view_dependent_lod& lod, const contraction_hierarchy& h,
 inline bool finish_panel(demo_context& ctx, const support::embree_device& device, const indexed_mesh& m,
                          const std::vector<double>& saliency, const support::mesh_view_options& view,
                          lod_panel& p, const support::image* full) {
+  char tag[64];  // e.g. "infolerp 5%", for the time lines
+  std::snprintf(tag, sizeof tag, "%s %g%%", p.method.c_str(), 100.0 * p.fraction);
+  const stopwatch render_watch;
   auto imgs = support::render_mesh_views(device, m.positions, p.indices, view);
   if (!imgs) return report(imgs.error()), false;
+  record_time(ctx, std::string("LOD view ") + tag, render_watch.seconds());
   p.img = std::move((*imgs)[0]);
   lod_result r{p.method, p.fraction, p.indices.size() / 3, p.seconds, 0.0, 0.0, std::numeric_limits<double>::infinity(), 1.0};
   if (full) {
@@ -106,7 +111,11 @@ inline bool finish_panel(demo_context& ctx, const support::embree_device& device
     if (!sim) return report(sim.error()), false;
     r.psnr = sim->psnr, r.ssim = sim->ssim;
   }
-  const support::distances d = support::measure(m, saliency, p.indices);
+  const stopwatch metric_watch;
+  progress_line metric_line(std::string("LOD metric ") + tag);
+  const support::distances d = support::measure(m, saliency, p.indices, with_progress(ctx.options, metric_line));
+  metric_line.finish();
+  record_time(ctx, std::string("LOD metric ") + tag, metric_watch.seconds());
   r.weighted_distance = d.weighted, r.hausdorff = d.hausdorff;
   char text[160];
   if (full)
@@ -216,21 +225,43 @@ inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, v
 
 inline bool stage_lod(demo_context& ctx) {
   std::vector<std::uint32_t> remap;
-  const indexed_mesh m = support::weld_positions(detail::lod_source(ctx), remap);
-  auto sal = compute_saliency(m);
-  if (!sal) return report(sal.error()), false;
+  const indexed_mesh& source = detail::lod_source(ctx);
+  const indexed_mesh m = support::weld_positions(source, remap);
+  // The saliency stage's values for this object (the same welded mesh), else computed here.
+  std::vector<double> saliency;
+  for (std::size_t g = 0; g < ctx.welded_saliency.size(); ++g)
+    if (&ctx.scene.objects[g].mesh == &source) saliency = ctx.welded_saliency[g];
+  if (saliency.empty()) {
+    const stopwatch watch;
+    progress_line line("LOD saliency");
+    auto sal = compute_saliency(m, {}, with_progress(ctx.options, line));
+    line.finish();
+    if (!sal) return report(sal.error()), false;
+    saliency = std::move(sal->saliency);
+    record_time(ctx, "LOD saliency", watch.seconds());
+  }
+  stopwatch watch;
   // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
-  auto cl = salient_clustering(m, sal->saliency, {.clusters = clusters});
+  progress_line cl_line("LOD salient clustering");
+  auto cl = [&] { const heartbeat beat(cl_line); return salient_clustering(m, saliency, {.clusters = clusters}); }();
+  cl_line.finish();
   if (!cl) return report(cl.error()), false;
-  auto w = weighting_map(m, sal->saliency, cl->cluster, cl->count);
+  record_time(ctx, "LOD salient clustering (" + std::to_string(cl->iterations) + " growth rounds)", watch.seconds());
+  watch = {};
+  progress_line build_line("LOD build");
+  std::optional<heartbeat> beat(std::in_place, build_line);
+  auto w = weighting_map(m, saliency, cl->cluster, cl->count);
   if (!w) return report(w.error()), false;
   auto h = make_contraction_hierarchy(m, *w, cl->cluster, cl->count);
   if (!h) return report(h.error()), false;
-  auto table = compute_cluster_attributes(m, sal->saliency, cl->cluster, cl->count);
+  auto table = compute_cluster_attributes(m, saliency, cl->cluster, cl->count);
   if (!table) return report(table.error()), false;
   auto lod = view_dependent_lod::create(*h, *table);
   if (!lod) return report(lod.error()), false;
+  beat.reset();
+  build_line.finish();
+  record_time(ctx, "LOD build (weights, hierarchy, table)", watch.seconds());
 
   const int side = std::max(16, std::min({ctx.options.width, ctx.options.height, 384}));
   const support::mesh_view_options view{side, side, 1, ctx.options.shader, ctx.options.threads};
@@ -239,13 +270,13 @@ inline bool stage_lod(demo_context& ctx) {
   const std::size_t nt = m.triangle_count();
   const auto* full_idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
   detail::lod_panel full{"full", 1.0, {full_idx, full_idx + 3 * nt}, 0.0, {}, {}};
-  if (!detail::finish_panel(ctx, device, m, sal->saliency, view, full, nullptr)) return false;
+  if (!detail::finish_panel(ctx, device, m, saliency, view, full, nullptr)) return false;
 
   std::vector<detail::lod_panel> panels;
   for (const double f : {0.35, 0.05}) {
     detail::lod_panel ours{"infolerp", f, {}, 0.0, {}, {}};
     if (auto s = detail::lod_frame(*lod, *h, detail::lod_eye(cam, side), nt, ours); !s) return report(s), false;
-    if (!detail::finish_panel(ctx, device, m, sal->saliency, view, ours, &full.img)) return false;
+    if (!detail::finish_panel(ctx, device, m, saliency, view, ours, &full.img)) return false;
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
     detail::lod_panel theirs{"meshoptimizer", f, std::vector<std::uint32_t>(3 * nt), 0.0, {}, {}};
     const auto t1 = std::chrono::steady_clock::now();
@@ -253,7 +284,7 @@ inline bool stage_lod(demo_context& ctx) {
                                            sizeof(glm::vec3), ours.indices.size(), std::numeric_limits<float>::max(), 0, nullptr);
     theirs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     theirs.indices.resize(k);
-    if (!detail::finish_panel(ctx, device, m, sal->saliency, view, theirs, &full.img)) return false;
+    if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
 #else
     detail::lod_panel theirs;
 #endif

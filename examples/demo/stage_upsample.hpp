@@ -58,6 +58,8 @@ inline support::image error_heat_map(const support::image& img, const support::i
 }  // namespace detail
 
 inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* clusters = nullptr) {
+  const stopwatch watch;
+  double frames = 0.0;  // the rows' frame times, recorded one by one
   const auto& o = ctx.options;
   // The I-Buffer's ids: the clusters cut at texture seams (texcoords are interpolated within an id).
   const auto split =
@@ -84,11 +86,7 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
     return false;
   }
   const auto& src = *ready;
-#ifdef _OPENMP
-  const openmp_executor exec{o.threads};
-#else
-  const serial_executor exec{};
-#endif
+  const stage_executor exec = make_executor(o);
   support::image img(o.width, o.height);
   const std::string cluster_note = clusters->name + ", " + std::to_string(clusters->count()) + " clusters";
   auto render = [&](std::uint32_t passes) {
@@ -99,6 +97,8 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
     const auto& r = add_result(ctx, method, setting, up->stats().seconds, up->stats().evaluated_fraction(), img);
     std::printf("%-12s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
                 ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());
+    record_time(ctx, "I-Buffer row " + r.method, r.seconds);
+    frames += r.seconds;
   };
 
   // The trade-off runs; the shown frame's pass count is rendered last (below) so that its image
@@ -140,6 +140,8 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
                                  pu->stats().seconds, pu->stats().evaluated_fraction(), img);
       std::printf("%-16s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
                   ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());
+      record_time(ctx, "I-Buffer row " + r.method, r.seconds);
+      frames += r.seconds;
     }
   }
 
@@ -171,7 +173,9 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
         return false;
       }
       std::printf("auto: frame %d: %u pass%s %.3f s\n", frame, rendered, rendered == 1 ? "" : "es", up->stats().seconds);
+      frames += up->stats().seconds;
     }
+    frames -= up->stats().seconds;  // the last frame is recorded as the row below
     chosen = "ibuffer-auto";
     record(chosen, "pass controller chose " + std::to_string(rendered) + (rendered == 1 ? " pass, " : " passes, ") + cluster_note);
   }
@@ -188,8 +192,10 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
   const auto kinds = up->kinds();
   for (std::size_t i = 0; i < kinds.size(); ++i) rie.pixels[i] = colours[static_cast<int>(kinds[i])];
 
-  return save_png(ctx, img, "ibuffer.png") && save_png(ctx, rie, "rie.png") &&
-         save_png(ctx, detail::error_heat_map(img, ctx.reference), "error.png");
+  const bool saved = save_png(ctx, img, "ibuffer.png") && save_png(ctx, rie, "rie.png") &&
+                     save_png(ctx, detail::error_heat_map(img, ctx.reference), "error.png");
+  record_time(ctx, "I-Buffer: ids, sources, PSNR/SSIM, images", watch.seconds() - frames);
+  return saved;
 }
 
 }  // namespace infolerp::demo

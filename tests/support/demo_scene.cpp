@@ -1,7 +1,9 @@
 #include "support/demo_scene.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <map>
 #include <string_view>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -145,23 +147,37 @@ result<std::vector<textured_part>> load_parts(const std::string& path) {
   return parts;
 }
 
-// Loads an asset (Y-up, as most OBJ/glTF/OFF/PLY files are: turned to this scene's Z-up), scales
-// it so its largest extent is `size`, standing on the ground at `where` (x, y), one object per
-// part. Normals the file lacks are area-weighted vertex normals; the file's are turned with it.
-result<std::vector<scene_object>> load_fitted_asset(const std::string& path, float size, glm::vec2 where) {
-  auto parts = load_parts(path);
-  if (!parts) return parts.error();
-  const glm::mat4 up = glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f));
+// One part of an asset group with the file it came from.
+struct loaded_part {
+  std::string path;
+  textured_part part;
+};
+
+// Loads a group of files that belong together (one --mesh file, or the files of one --group),
+// turns them Z-up (a Y-up file is rotated +90° about X; Z-up files stay as they are), scales the
+// whole group so that its largest extent is `size` and stands it on the ground at `where` (x,
+// y): the files keep their relative placement and scale. One object per part. Normals the file
+// lacks are area-weighted vertex normals; the file's are turned with it.
+result<std::vector<scene_object>> load_fitted_group(const std::vector<std::string>& paths, bool z_up, float size,
+                                                    glm::vec2 where) {
+  const glm::mat4 up = z_up ? glm::mat4(1.0f) : glm::rotate(glm::mat4(1.0f), 0.5f * pi, glm::vec3(1.0f, 0.0f, 0.0f));
+  std::vector<loaded_part> parts;
   indexed_mesh all;
-  for (auto& part : *parts) {
-    part.mesh = moved(part.mesh, up);
-    append(all, part.mesh);
+  for (const auto& path : paths) {
+    auto loaded = load_parts(path);
+    if (!loaded) return loaded.error();
+    for (auto& part : *loaded) {
+      part.mesh = moved(part.mesh, up);
+      append(all, part.mesh);
+      parts.push_back({path, std::move(part)});
+    }
   }
   const bounding_box box = mesh_bounds(all);
   const glm::dvec3 extent = box.hi - box.lo;
   const double largest = std::max({extent.x, extent.y, extent.z});
   if (!(largest > 0.0) || !std::isfinite(largest))
-    return make_error(errc::degenerate_triangle, no_element, "mesh '", path, "' has no extent (or non-finite positions)");
+    return make_error(errc::degenerate_triangle, no_element, "mesh '", paths.front(), "'", paths.size() > 1 ? " and the rest of its group" : "",
+                      " has no extent (or non-finite positions)");
   const auto s = static_cast<float>(size / largest);
   const glm::vec3 c(box.center());
   const glm::vec3 base(c.x, c.y, static_cast<float>(box.lo.z));
@@ -169,7 +185,8 @@ result<std::vector<scene_object>> load_fitted_asset(const std::string& path, flo
   m = glm::scale(m, glm::vec3(s));
   m = glm::translate(m, -base);
   std::vector<scene_object> out;
-  for (auto& part : *parts) {
+  for (auto& [file, part] : parts) {
+    const std::string& path = file;  // named, not a binding: lambdas capture it
     indexed_mesh mesh = moved(part.mesh, m);
     if (!mesh.has_normals()) mesh.normals = vertex_normals(mesh);
     for (auto& n : mesh.normals) n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 0.0f, 1.0f);
@@ -179,7 +196,8 @@ result<std::vector<scene_object>> load_fitted_asset(const std::string& path, flo
       mat.image = part.image;
       mat.texels_per_unit = texel_density(mesh, *part.image);
     }
-    const std::string name = parts->size() == 1 && part.material.empty() ? path : path + " [" + part.material + "]";
+    const bool alone = std::count_if(parts.begin(), parts.end(), [&](const loaded_part& p) { return p.path == path; }) == 1;
+    const std::string name = alone && part.material.empty() ? path : path + " [" + part.material + "]";
     out.push_back({name, std::move(mesh), std::move(mat), std::move(part.note)});
   }
   return out;
@@ -201,9 +219,29 @@ status tessellate_for_view(indexed_mesh& m, const camera& c, float max_fraction)
   return {};
 }
 
+// The asset slots: each --group's files together (in the order of their first file), each
+// other file alone.
+std::vector<std::vector<std::string>> asset_groups(const demo_scene_options& o) {
+  std::vector<std::vector<std::string>> groups;
+  std::map<std::string, std::size_t> slot;
+  for (std::size_t i = 0; i < o.mesh_paths.size(); ++i) {
+    const std::string group = i < o.mesh_groups.size() ? o.mesh_groups[i] : std::string();
+    if (group.empty()) {
+      groups.push_back({o.mesh_paths[i]});
+      continue;
+    }
+    const auto [it, added] = slot.try_emplace(group, groups.size());
+    if (added) groups.emplace_back();
+    groups[it->second].push_back(o.mesh_paths[i]);
+  }
+  return groups;
+}
+
 }  // namespace
 
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
   std::vector<scene_object> objects;
 
   // Ground: 16 x 16 units of bricks (48 rows).
@@ -241,13 +279,14 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
     objects.push_back({"boxes", std::move(boxes), {texture_kind::solid, {0.55f, 0.6f, 0.55f}, {}, {1.0f, 1.0f}, 0.0f}});
   }
 
-  // Assets side by side along x in front of the built-in objects, then a row further back.
-  for (std::size_t i = 0; i < options.mesh_paths.size(); ++i) {
+  // Assets (groups) side by side along x in front of the built-in objects, then a row further back.
+  const auto groups = asset_groups(options);
+  for (std::size_t i = 0; i < groups.size(); ++i) {
     const float step = options.mesh_size * 1.2f;
     const std::size_t k = i % 5;  // columns at 0, +1, -1, +2, -2 steps
     const float column = static_cast<float>((k + 1) / 2) * (k % 2 == 1 ? 1.0f : -1.0f);
     const glm::vec2 where{0.2f + column * step, -2.4f - static_cast<float>(i / 5) * step};
-    auto user = load_fitted_asset(options.mesh_paths[i], options.mesh_size, where);
+    auto user = load_fitted_group(groups[i], options.z_up, options.mesh_size, where);
     if (!user) return user.error();
     for (auto& object : *user) objects.push_back(std::move(object));
   }
@@ -259,6 +298,7 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
     if (options.tessellate > 0.0f)
       if (auto s = tessellate_for_view(object.mesh, view, options.tessellate); !s) return s;
 
+  const auto t1 = clock::now();
   embree_scene tracer{device};
   for (const auto& object : objects) {
     auto id = tracer.add_mesh(object.mesh);
@@ -268,6 +308,8 @@ result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene
 
   demo_scene scene{std::move(tracer)};
   scene.objects = std::move(objects);
+  scene.load_seconds = std::chrono::duration<double>(t1 - t0).count();
+  scene.bvh_seconds = std::chrono::duration<double>(clock::now() - t1).count();
   scene.view = view;
   scene.sun = {glm::normalize(glm::vec3(0.6f, -0.35f, 0.75f)), {1.0f, 0.92f, 0.8f}};
   scene.area = {{-1.2f, -1.2f, 4.5f}, {0.0f, 2.4f, 0.0f}, {2.4f, 0.0f, 0.0f}, {2.2f, 2.2f, 2.4f}};

@@ -110,6 +110,8 @@ struct demo_scene {
   glm::vec3 ambient{0.25f, 0.28f, 0.34f};  // sky light reaching an unoccluded surface (scaled by AO)
   float ao_radius = 1.5f;               // ambient-occlusion rays look this far
   float ray_offset = 1e-3f;             // secondary rays start this far off the surface
+  double load_seconds = 0.0;            // make_demo_scene's wall time making and loading the objects
+  double bvh_seconds = 0.0;             // and building the tracer's BVH (Embree commit)
 
   explicit demo_scene(embree_scene t) : tracer(std::move(t)) {}
 };
@@ -122,6 +124,10 @@ struct demo_scene_options {
   unsigned torus_major = 64;      // torus tessellation
   unsigned torus_minor = 24;
   unsigned ground_cells = 16;     // ground plane quads per side
+  // Per mesh path, the group it belongs to ("" or missing: alone). A group's files are placed
+  // and scaled together, keeping their relative placement and scale (e.g. a car and its wheel).
+  std::vector<std::string> mesh_groups{};
+  bool z_up = false;              // the assets are Z-up (as this scene); false: Y-up, turned +90° about X
   // §4.1 of the clustering paper: every object's triangles split 1:4 (closure only) until none
   // covers more than this share of a square image of the scene's view (0: not tessellated).
   float tessellate = 0.0f;
@@ -129,9 +135,9 @@ struct demo_scene_options {
 
 // Builds the scene on `device` and commits its tracer. Each asset adds one object per material
 // (named "FILE [material]"), textured when the material has a diffuse texture and the mesh
-// texcoords; assets stand side by side in front of the built-in objects. Errors: an asset or
-// its texture cannot be loaded (the message names the file) or has no triangles Embree accepts,
-// tessellate not in [0, 1].
+// texcoords; assets (a group counts as one) stand side by side in front of the built-in
+// objects. Errors: an asset or its texture cannot be loaded (the message names the file) or has
+// no triangles Embree accepts, tessellate not in [0, 1].
 result<demo_scene> make_demo_scene(const embree_device& device, const demo_scene_options& options = {});
 
 // Level-0 texels per world unit of `image` on mesh m: sqrt(texture area covered / surface area),
