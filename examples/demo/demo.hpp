@@ -43,6 +43,7 @@ struct demo_options {
   std::vector<std::string> mesh_paths;  // --mesh FILE, repeatable (none: built-in scene only)
   std::vector<std::string> mesh_groups;  // per mesh path: the --group NAME before it ("" when none)
   bool z_up = false;                 // --up z: the assets are Z-up (default y: Y-up)
+  float tessellate = 0.0f;           // --tessellate SHARE: triangles split until none covers more of the image
   support::shader_options shader;    // --ao N, --soft N
   std::uint32_t passes = 4;          // --passes K: I-Buffer passes of ibuffer.png; 0 = auto (pass controller)
   std::map<std::string, float> thresholds;  // --threshold CHANNEL=VALUE: channel (visibility,

@@ -37,6 +37,9 @@ constexpr const char* usage =
     "                  keep their relative placement and scale (e.g. a car body and its wheels)\n"
     "  --up y|z        the assets' up axis (default y; z for Z-up files, as many game assets)\n"
     "  --size W H      image size in pixels (default 1025 1025)\n"
+    "  --tessellate SHARE\n"
+    "                  split the scene's triangles 1:4 until none covers more than SHARE (0-1) of\n"
+    "                  the image (clustering paper 4.1; default 0: off)\n"
     "  --passes K|auto I-Buffer passes of ibuffer.png (1-16, default 4); auto: the pass controller\n"
     "                  (frame-time bounds 1/60-1/30 s, at most 4 passes)\n"
     "  --threshold CHANNEL=VALUE\n"
@@ -108,6 +111,12 @@ std::optional<demo::demo_options> parse_options(int argc, char** argv) {
       if (!need(2) || !parse_int(argv[i + 1], 1, 16384, o.width) || !parse_int(argv[i + 2], 1, 16384, o.height))
         return fail("--size needs two integers W H in [1, 16384]");
       i += 2;
+    } else if (arg == "--tessellate") {
+      const std::string_view text = need(1) ? argv[i + 1] : "";
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), o.tessellate);
+      if (text.empty() || ec != std::errc{} || end != text.data() + text.size() || !(o.tessellate >= 0.0f && o.tessellate <= 1.0f))
+        return fail("--tessellate needs a share of the image in [0, 1]");
+      ++i;
     } else if (arg == "--threads") {
       if (!need(1) || !parse_int(argv[++i], 1, 1024, o.threads)) return fail("--threads needs an integer in [1, 1024]");
     } else if (arg == "--ao" || arg == "--soft") {
@@ -192,7 +201,10 @@ int main(int argc, char** argv) {
   support::enable_flush_to_zero();
   const std::string embree_config = options->threads > 0 ? "threads=" + std::to_string(options->threads) : "";
   const support::embree_device device(embree_config.c_str());
-  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths, .mesh_groups = options->mesh_groups, .z_up = options->z_up});
+  auto scene = support::make_demo_scene(device, {.mesh_paths = options->mesh_paths,
+                                                 .mesh_groups = options->mesh_groups,
+                                                 .z_up = options->z_up,
+                                                 .tessellate = options->tessellate});
   if (!scene) {
     demo::report(scene.error());
     return 1;
