@@ -45,6 +45,7 @@
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
+#include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 #include "infolerp/lod/weighting_map.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"

@@ -344,45 +344,6 @@ TEST_CASE("driver: options and cameras at their extremes get a status naming the
   CHECK(r.visible_leaves().empty());  // nothing was taken
 }
 
-TEST_CASE("criteria: NLD_IS recurses below quadrants with S <= S_req down to pixel size and stops at its pixel fraction") {
-  // 16x16 image over the floor's two triangles (left half: 0, right half: 1), luminance 0.5
-  // everywhere but a bright 2x2 spot at (5..6, 5..6): every quadrant of the first two levels has
-  // four equal corners (S = 0), so only the recursion the paper describes (§4: each quadrant is
-  // subdivided into four, down to one pixel; S_req gates the triangle's subdivision) finds it.
-  auto mesh = subdivision_mesh::create(floor_mesh());
-  REQUIRE(mesh.ok());
-  const std::uint32_t w = 16, h = 16;
-  std::vector<std::uint32_t> pixel_leaf(w * h), leaf_pixels{128, 128};
-  std::vector<float> lum(w * h, 0.5f);
-  for (std::uint32_t y = 0; y < h; ++y)
-    for (std::uint32_t x = 0; x < w; ++x) pixel_leaf[y * w + x] = x < 8 ? 0u : 1u;
-  for (std::uint32_t y = 5; y < 7; ++y)
-    for (std::uint32_t x = 5; x < 7; ++x) lum[y * w + x] = 1.0f;
-  const std::vector<std::uint32_t> visible{0, 1};
-  refinement_frame f;
-  f.width = w;
-  f.height = h;
-  f.mesh = &*mesh;
-  f.pixel_leaf = pixel_leaf;
-  f.pixel_luminance = lum;
-  f.leaf_pixels = leaf_pixels;
-  f.visible = visible;
-  f.l_max = 1.0f;
-  const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = 0.05f, .batch = 8, .nld_is_pixel_fraction = 0.25f};
-  std::vector<std::uint32_t> out;
-  f.view_samples = 63;  // below 0.25 · 256 pixels: the walk runs to pixel size
-  select_nld_is(f, o, out);
-  CHECK(out == std::vector<std::uint32_t>{0});  // the spot's triangle, once; the flat right half never
-  out.clear();
-  f.view_samples = 64;  // the fraction is reached: nothing more in this view
-  select_nld_is(f, o, out);
-  CHECK(out.empty());
-  std::fill(lum.begin(), lum.end(), 0.5f);  // a flat image: the walk reaches pixel size and selects nothing
-  f.view_samples = 0;
-  select_nld_is(f, o, out);
-  CHECK(out.empty());
-}
-
 TEST_CASE("criteria: NLD_OS kept between batches selects what the full scan selects, batch after batch") {
   // A view simulated on a subdivided plane: every new leaf gets a pixel count (some none, some
   // above the always-refine fraction) and every new vertex a luminance from five levels (so S

@@ -11,14 +11,10 @@
 //  - NLD_OS ranks its candidates: triangles above the `always_refine_fraction` of the image
 //    first (largest first), then by S (largest first), ties by id; it takes the first R.
 //  - NLD_IS is a best-first walk of the image quadtree: the quadrant with the largest S (over
-//    its four corner pixels) is expanded first; if S > S_req the triangle under its centre is
-//    selected (once), and in either case its four sub-quadrants are queued, down to one pixel
-//    (§4: the process recurses into every quadrant; S_req gates the subdivision, not the
-//    recursion, so a feature inside a quadrant with equal corners is still found). It ends
-//    (§4) when the walk reaches pixel size without a selection or once the samples requested in
-//    the current view reach `nld_is_pixel_fraction` of the pixel count (checked per batch, so
-//    the last batch may overshoot by its own requests); the paper gives no value for the
-//    fraction, so it defaults to none (infinity) and the walk's own end stops it.
+//    its four corner pixels) is expanded first; while S > S_req the triangle under its centre is
+//    selected (once) and its four sub-quadrants are queued, down to one pixel. It also ends
+//    (§4) once the samples requested in the current view reach `nld_is_pixel_fraction` of the
+//    pixel count (checked per batch, so the last batch may overshoot by its own requests).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
@@ -149,8 +145,7 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
 }
 
 // NLD_IS (§4): best-first quadtree walk over the interpolated image (see the header comment).
-// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited
-// (Q <= 4/3 · pixels; all of them in a batch that finds fewer than R); allocation O(Q).
+// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
 inline void select_nld_is(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
   if (f.width == 0 || f.height == 0) return;
   if (double(f.view_samples) >= double(o.nld_is_pixel_fraction) * double(f.width) * double(f.height)) return;
@@ -181,8 +176,9 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
   while (!heap.empty() && out.size() < goal) {
     const quad q = heap.top();
     heap.pop();
+    if (!(q.s > o.s_req)) break;  // every other quadrant has an S at most this large
     const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
-    if (q.s > o.s_req && leaf != invalid_id && float(f.leaf_pixels[leaf]) >= o.min_pixels &&
+    if (leaf != invalid_id && float(f.leaf_pixels[leaf]) >= o.min_pixels &&
         std::find(chosen.begin(), chosen.end(), leaf) == chosen.end()) {
       chosen.push_back(leaf);
       out.push_back(leaf);
