@@ -30,6 +30,7 @@
 #include "support/demo_upsample.hpp"
 #include "support/embree_tracer.hpp"
 #include "support/image.hpp"
+#include "support/mesh_io.hpp"
 #include "support/reference_shader.hpp"
 #include "support/ssim.hpp"
 
@@ -256,8 +257,7 @@ inline void record_time(demo_context& ctx, std::string stage, double seconds) {
 
 // One line on stderr for a failed status (without the library's "infolerp: " prefix).
 inline void report(const status& s) {
-  std::string_view m = s.message();
-  if (m.starts_with("infolerp: ")) m.remove_prefix(10);
+  const std::string_view m = support::bare_message(s);
   std::fprintf(stderr, "infolerp_demo: %.*s\n", static_cast<int>(m.size()), m.data());
 }
 

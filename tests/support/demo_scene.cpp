@@ -121,11 +121,8 @@ indexed_mesh moved(const indexed_mesh& src, const glm::mat4& m) {
 // the bounds). Degenerate triangles and non-manifold edges are accepted: the tracer and the
 // demo's stages handle them.
 status check_mesh(const indexed_mesh& m, const std::string& path) {
-  if (auto s = validate_mesh(m, {.allow_degenerate = true, .allow_non_manifold = true, .check_unused_vertices = true}); !s) {
-    std::string_view text = s.message();
-    if (text.starts_with("infolerp: ")) text.remove_prefix(10);
-    return make_error(s.code(), s.element(), "mesh '", path, "': ", std::string(text));
-  }
+  if (auto s = validate_mesh(m, {.allow_degenerate = true, .allow_non_manifold = true, .check_unused_vertices = true}); !s)
+    return in_mesh(s, path);
   return {};
 }
 

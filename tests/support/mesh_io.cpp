@@ -41,11 +41,7 @@ result<std::shared_ptr<const texture>> material_texture(const aiScene& scene, co
                ? decode_texture(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(embedded->pcData), embedded->mWidth),
                                 path + ":" + name.C_Str())
                : load_texture((std::filesystem::path(path).parent_path() / name.C_Str()).string());
-  if (!t) {  // the message names the texture; say which asset wants it
-    std::string_view text = t.error().message();
-    if (text.starts_with("infolerp: ")) text.remove_prefix(10);
-    return make_error(t.error().code(), no_element, "mesh '", path, "': ", std::string(text));
-  }
+  if (!t) return in_mesh(t.error(), path);  // the message names the texture; say which asset wants it
   return std::shared_ptr<const texture>(std::make_shared<texture>(std::move(*t)));
 }
 
@@ -233,10 +229,8 @@ result<std::vector<textured_part>> load_textured_mesh_here(const std::string& pa
 
 // The loaders' results through run_in_child: an error as its code and message, a value field by field.
 void put(byte_writer& out, const status& s) {
-  std::string_view text = s.message();
-  if (text.starts_with("infolerp: ")) text.remove_prefix(10);
   out.put(s.code());
-  out.put(std::string(text));
+  out.put(std::string(bare_message(s)));
 }
 void put(byte_writer& out, const indexed_mesh& m) {
   out.put(m.positions);
@@ -244,11 +238,12 @@ void put(byte_writer& out, const indexed_mesh& m) {
   out.put(m.texcoords);
   out.put(m.normals);
 }
-void get(byte_reader& in, indexed_mesh& m) {
+status get(byte_reader& in, indexed_mesh& m) {
   in.get(m.positions);
   in.get(m.triangles);
   in.get(m.texcoords);
   in.get(m.normals);
+  return {};
 }
 void put(byte_writer& out, const std::vector<textured_part>& parts) {
   out.put(parts.size());
@@ -270,7 +265,7 @@ status get(byte_reader& in, std::vector<textured_part>& parts) {
   for (std::size_t k = 0; k < n && in.good(); ++k) {
     textured_part& p = parts.emplace_back();
     in.get(p.material);
-    get(in, p.mesh);
+    if (auto s = get(in, p.mesh); !s) return s;
     in.get(p.diffuse);
     in.get(p.note);
     texture_level image;
@@ -309,8 +304,7 @@ result<T> load_in_child(const std::string& path, result<T> (*load)(const std::st
   errc code = errc::ok;
   std::string message;
   if (ok) {
-    if constexpr (std::is_same_v<T, indexed_mesh>) get(in, value);
-    else if (auto s = get(in, value); !s) return s;
+    if (auto s = get(in, value); !s) return s;
   } else {
     in.get(code);
     in.get(message);
@@ -446,6 +440,16 @@ result<indexed_mesh> read_off(const std::string& path) {
   }
   if (out.triangles.empty()) return make_error(errc::empty_input, no_element, "mesh file '", path, "' holds no triangles");
   return out;
+}
+
+std::string_view bare_message(const status& s) {
+  std::string_view text = s.message();
+  if (text.starts_with("infolerp: ")) text.remove_prefix(10);
+  return text;
+}
+
+status in_mesh(const status& s, const std::string& path) {
+  return make_error(s.code(), s.element(), "mesh '", path, "': ", std::string(bare_message(s)));
 }
 
 std::string cgal_mesh(const std::string& name) { return std::string(INFOLERP_DATA_DIR) + "/" + name + ".off"; }

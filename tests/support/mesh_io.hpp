@@ -6,6 +6,7 @@
 // plus 1 s per MB; its death or hang is an error naming the file.
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 #include <glm/vec3.hpp>
 #include "infolerp/core/status.hpp"
@@ -49,6 +50,11 @@ result<std::vector<textured_part>> load_textured_mesh(const std::string& path);
 // before allocating), a truncated or non-numeric vertex or face list, a face with fewer than 3
 // vertices; the message names the file and the line. Memory: O(file size).
 result<indexed_mesh> read_off(const std::string& path);
+// The message of s without the library's "infolerp: " prefix, for messages that add context.
+std::string_view bare_message(const status& s);
+// s's error (same code and element) with "mesh 'PATH': " before its message.
+status in_mesh(const status& s, const std::string& path);
+
 // Path of one of CGAL's meshes unpacked by cmake/install-deps.sh, e.g. cgal_mesh("bunny00").
 std::string cgal_mesh(const std::string& name);
 
