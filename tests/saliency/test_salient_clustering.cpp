@@ -1,6 +1,6 @@
-// saliency/salient_clustering.hpp: partition invariants, determinism, distinct seeds and no
-// empty cluster, the flat tie-break (a plane, fandisk), the seed tolerance, unreached
-// components, the PRNG's reference sequence, and eq. (4) on a hand-checked case.
+// saliency/salient_clustering.hpp: partition invariants, determinism (per seed, per executor),
+// distinct seeds and no empty cluster, the flat tie-break (a plane, fandisk), the seed
+// tolerance, unreached components, the PRNG's reference sequence, and eq. (4) by hand.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include "infolerp/saliency/salient_clustering.hpp"
 #include "support/mesh_io.hpp"
 #include "support/procedural.hpp"
+#include "support/thread_pool.hpp"
 
 namespace {
 infolerp::indexed_mesh bumpy_sphere() {
@@ -264,6 +265,22 @@ TEST_CASE("salient clustering: seed_tolerance cuts the exact test's rounds short
   REQUIRE(cut.ok());
   CHECK(cut->cluster == near->cluster);
   CHECK(cut->seeds == near->seeds);
+}
+
+TEST_CASE("salient clustering: the same clusters for every executor and thread count") {
+  const auto m = bumpy_sphere();
+  auto s = infolerp::compute_saliency(m);
+  REQUIRE(s.ok());
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const infolerp::salient_clustering_options opt{.clusters = 10, .seed = seed};
+    auto serial = infolerp::salient_clustering(m, s->saliency, opt);
+    auto pooled = infolerp::salient_clustering(m, s->saliency, opt, infolerp::support::thread_pool_executor{3});
+    REQUIRE(serial.ok());
+    REQUIRE(pooled.ok());
+    CHECK(pooled->cluster == serial->cluster);
+    CHECK(pooled->seeds == serial->seeds);
+    CHECK(pooled->iterations == serial->iterations);
+  }
 }
 
 TEST_CASE("salient clustering: unreached components get their own cluster") {

@@ -47,11 +47,13 @@
 #include <limits>
 #include <numbers>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/detail/csr.hpp"
+#include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
@@ -147,7 +149,7 @@ struct clustering_workspace {
     std::uint32_t face;  // internal face
   };
   std::vector<grow_entry> grow_heap;
-  std::vector<dist_entry> dist_heap;
+  std::vector<std::vector<dist_entry>> dist_heaps;  // re-seeding: one per cluster
   struct grow_state {  // growth, per face: what a neighbour visit reads and writes, in one place
     double cost;              // of the face's best push so far; −∞ for a face around a seed vertex
     std::uint32_t cluster;    // of that push
@@ -283,24 +285,59 @@ std::uint32_t latest_free_seed(const M& m, const face_data& fd, std::span<const 
   return invalid_id;
 }
 
-// Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
-// Dijkstra search from the cluster's border faces inward (ties: original face index), among
-// the vertices that can seed it (can_seed; otherwise the faces reached before, latest first).
-template <class M>
-std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
-                                  std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
-                                  clustering_workspace& ws) {
+// Re-seeding's search for cluster c (eq. 3 costs): Dijkstra from its border faces
+// (ws.border_offsets/border) inward over its own faces; distances go to ws.dist (only c's
+// faces are written, so clusters may run concurrently, each with its own heap). Returns the
+// face popped last (the farthest; ties: original face index), or invalid_id without border.
+inline std::uint32_t farthest_from_border(const face_data& fd, std::span<const std::uint32_t> label, std::uint32_t c,
+                                          double smax, clustering_workspace& ws,
+                                          std::vector<clustering_workspace::dist_entry>& heap) {
   using entry = clustering_workspace::dist_entry;
-  const std::size_t nt = label.size(), C = old_seeds.size();
-  std::vector<double> smax(C, 0.0);
-  for (std::size_t f = 0; f < nt; ++f)
-    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.hot[f].saliency);
   const auto greater = [&](const entry& x, const entry& y) {
     return x.dist != y.dist ? x.dist > y.dist : fd.original[x.face] > fd.original[y.face];
   };
+  heap.clear();
+  for (std::uint32_t k = ws.border_offsets[c]; k < ws.border_offsets[c + 1]; ++k)
+    ws.dist[ws.border[k]] = 0.0, heap.push_back({0.0, ws.border[k]});
+  std::make_heap(heap.begin(), heap.end(), greater);
+  const double scale = smax > 0.0 ? 1.0 / smax : 0.0;
+  std::uint32_t last = invalid_id;
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), greater);
+    const auto [d, f] = heap.back();
+    heap.pop_back();
+    if (d > ws.dist[f]) continue;
+    last = f;  // popped in ascending distance: the final pop is the farthest
+    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
+      const std::uint32_t g = fd.nb[k];
+      if (label[g] != c) continue;
+      const double step = fd.step_length[k] * (smax > 0.0 ? fd.hot[g].saliency * scale : 1.0);
+      if (d + step < ws.dist[g]) {
+        ws.dist[g] = d + step;
+        heap.push_back({d + step, g});
+        std::push_heap(heap.begin(), heap.end(), greater);
+      }
+    }
+  }
+  return last;
+}
+
+// Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
+// Dijkstra search from the cluster's border faces inward (ties: original face index), among
+// the vertices that can seed it (can_seed; otherwise the faces reached before, latest first).
+// The clusters' searches run through exec, largest cluster first; the result does not depend
+// on the executor.
+template <class M, class E = serial_executor>
+std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
+                                  std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
+                                  clustering_workspace& ws, E&& exec = E{}) {
+  const std::size_t nt = label.size(), C = old_seeds.size();
+  std::vector<double> smax(C, 0.0);
+  std::vector<std::uint32_t> size(C, 0);
+  for (std::size_t f = 0; f < nt; ++f)
+    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.hot[f].saliency), ++size[label[f]];
   ws.dist.assign(nt, std::numeric_limits<double>::infinity());
-  // Border faces grouped by cluster: each cluster's search stays inside the cluster, so the
-  // clusters are searched one at a time (each over its own part of the face arrays).
+  // Border faces grouped by cluster: each cluster's search stays inside the cluster.
   auto& border_key = ws.border_key;
   border_key.assign(nt, no_bucket);
   for (std::size_t f = 0; f < nt; ++f) {
@@ -312,32 +349,16 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
   group_by_key(
       C, nt, [&](std::size_t f) { return border_key[f]; }, [](std::size_t f) { return static_cast<std::uint32_t>(f); },
       ws.border_offsets, ws.border);
-  std::vector<std::uint32_t> last(C, invalid_id);
-  auto& heap = ws.dist_heap;
-  for (std::uint32_t c = 0; c < C; ++c) {
-    heap.clear();
-    for (std::uint32_t k = ws.border_offsets[c]; k < ws.border_offsets[c + 1]; ++k)
-      ws.dist[ws.border[k]] = 0.0, heap.push_back({0.0, ws.border[k]});
-    std::make_heap(heap.begin(), heap.end(), greater);
-    const double scale = smax[c] > 0.0 ? 1.0 / smax[c] : 0.0;
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end(), greater);
-      const auto [d, f] = heap.back();
-      heap.pop_back();
-      if (d > ws.dist[f]) continue;
-      last[c] = f;  // popped in ascending distance: the final pop is the farthest
-      for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
-        const std::uint32_t g = fd.nb[k];
-        if (label[g] != c) continue;
-        const double step = fd.step_length[k] * (smax[c] > 0.0 ? fd.hot[g].saliency * scale : 1.0);
-        if (d + step < ws.dist[g]) {
-          ws.dist[g] = d + step;
-          heap.push_back({d + step, g});
-          std::push_heap(heap.begin(), heap.end(), greater);
-        }
-      }
+  std::vector<std::uint32_t> order(C), last(C, invalid_id);
+  for (std::uint32_t c = 0; c < C; ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] > size[b]; });
+  ws.dist_heaps.resize(C);
+  exec.parallel_for(C, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t c = order[i];
+      last[c] = farthest_from_border(fd, label, c, smax[c], ws, ws.dist_heaps[c]);
     }
-  }
+  });
   std::vector<std::uint32_t> seeds(old_seeds.begin(), old_seeds.end());
   ws.is_seed.assign(fd.vf_offsets.size() - 1, 0);
   for (std::size_t c = 0; c < C; ++c) {
@@ -386,12 +407,14 @@ bool seeds_repeat(const M& m, std::span<const std::uint32_t> next, std::span<con
 // not finite (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
-// reused by every round). Serial.
+// reused by every round). The growth is serial; re-seeding's per-cluster searches run through
+// exec (at most C at once), with the same result for every executor and thread count.
 // Pure: concurrent calls on the same mesh are safe.
-template <class M>
+template <class M, class E = serial_executor>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,
-                                            const salient_clustering_options& opt = {}) {
+                                            const salient_clustering_options& opt = {}, E&& exec = E{}) {
   static_assert(check_mesh<M>());
+  static_assert(check_executor<std::remove_cvref_t<E>>());
   if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
   const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
   if (saliency.size() != nv)
@@ -454,7 +477,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     ++out.iterations;
     history.push_back(seeds);
     if (out.iterations >= opt.max_iterations) break;
-    auto next = detail::reseed(m, fd, label, saliency, seeds, ws);
+    auto next = detail::reseed(m, fd, label, saliency, seeds, ws, exec);
     const std::vector<double> radius =
         opt.seed_tolerance > 0.0 ? detail::cluster_radii(fd, label, seeds.size()) : std::vector<double>{};
     const auto seen = std::find_if(history.begin(), history.end(), [&](const std::vector<std::uint32_t>& earlier) {
