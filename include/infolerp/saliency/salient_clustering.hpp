@@ -148,17 +148,17 @@ struct clustering_workspace {
     double dist;
     std::uint32_t face;  // internal face
   };
-  std::vector<grow_entry> grow_heap;
-  std::vector<std::vector<dist_entry>> dist_heaps;  // re-seeding: one per cluster
   struct grow_state {  // growth, per face: what a neighbour visit reads and writes, in one place
-    double cost;              // of the face's best push so far; −∞ for a face around a seed vertex
-    std::uint32_t cluster;    // of that push
-    std::uint32_t label;      // the cluster that took the face, or invalid_id
+    double cost;            // of the face's best push so far; −∞ for a face around a seed vertex
+    std::uint32_t cluster;  // of that push
+    std::uint32_t label;    // the cluster that took the face, or invalid_id
   };
-  std::vector<grow_state> grow;
-  std::vector<double> dist;  // re-seeding: per face
-  std::vector<char> is_seed;                // per vertex: chosen as a seed (seed selection)
+  std::vector<grow_entry> grow_heap;
+  std::vector<grow_state> grow;                     // growth: per face
+  std::vector<std::vector<dist_entry>> dist_heaps;  // re-seeding: one per cluster
+  std::vector<double> dist;                         // re-seeding: per face
   std::vector<std::uint32_t> border_key, border_offsets, border;  // re-seeding: border faces by cluster
+  std::vector<char> is_seed;                        // per vertex: chosen as a seed (seed selection)
 };
 
 // Whether v can seed the next cluster, given the seeds already chosen (marked in is_seed): v is
