@@ -244,7 +244,10 @@ inline bool stage_lod(demo_context& ctx) {
   // The paper's 10 clusters, or one per triangle on a mesh with fewer triangles.
   const auto clusters = static_cast<std::uint32_t>(std::min<std::size_t>(10, m.triangle_count()));
   progress_line cl_line("LOD salient clustering");
-  auto cl = [&] { const heartbeat beat(cl_line); return salient_clustering(m, saliency, {.clusters = clusters}); }();
+  auto cl = [&] {
+    const heartbeat beat(cl_line);
+    return salient_clustering(m, saliency, {.clusters = clusters}, make_executor(ctx.options));
+  }();
   cl_line.finish();
   if (!cl) return report(cl.error()), false;
   record_time(ctx, "LOD salient clustering (" + std::to_string(cl->iterations) + " growth rounds)", watch.seconds());

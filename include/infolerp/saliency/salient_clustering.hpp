@@ -28,6 +28,13 @@
 //   by another cluster's growth, so no seeded cluster ends empty.
 //   4. Repeat 2–3 until the seeds repeat a previous iteration's seeds (converged, or a cycle:
 //      the paper accepts any point on a cycle; we stop at the repeat) or max_iterations.
+//      The paper's test asks for the same vertices (seed_tolerance = 0, the default). With
+//      seed_tolerance > 0 (not in the paper) a seed also counts as repeated when it lies within
+//      seed_tolerance × its cluster's radius √(area/π) of that earlier seed: a test in units of
+//      the clusters, not of the mesh's resolution. The rounds wander before they repeat (each
+//      new seed is an argmax, so seeds jump), and how long is a matter of chance, not of the
+//      mesh's size; the tolerance stops the same walk at its first near-repeat (the result is
+//      the exact test's, cut short). Its effect on rounds and cluster quality: benchmarks/NOTES.md.
 // Face saliency S_f is the mean of its corners' vertex saliencies; x_f the centroid; n_f the
 // unit normal. Ties in every queue break by (cost, cluster, face), so the result is a function
 // of the mesh, the saliency and the seed only. Faces that no seed can reach (another connected
@@ -38,12 +45,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/detail/csr.hpp"
+#include "infolerp/core/executor.hpp"
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
@@ -60,6 +70,7 @@ struct salient_clustering_options {
   double normal_weight = 1.0;     // λ_n in eq. (2) (>= 1 keeps every cost non-negative)
   std::uint64_t seed = 1;         // user seed for drawing seeds from the pool
   std::uint32_t max_iterations = 50;  // growth + re-seeding rounds at most
+  double seed_tolerance = 0.0;    // seeds repeat within this × cluster radius (0: the same vertices)
   bool flat_tie_break = true;     // where eq. (2) costs 0, cost distance (see the top of this file)
 };
 
@@ -68,7 +79,7 @@ struct salient_clusters {
   std::vector<std::uint32_t> seeds;       // seed vertex of each seeded cluster (the last growth's)
   std::uint32_t count = 0;                // seeded clusters + extra ones for unreached components
   std::uint32_t iterations = 0;           // growth phases run
-  bool converged = false;                 // seeds repeated (a fixed point or a cycle)
+  bool converged = false;                 // seeds repeated, within seed_tolerance (a fixed point or a cycle)
   bool cycle = false;                     // the repeat was of an older iteration, not the last
 };
 
@@ -137,12 +148,17 @@ struct clustering_workspace {
     double dist;
     std::uint32_t face;  // internal face
   };
+  struct grow_state {  // growth, per face: what a neighbour visit reads and writes, in one place
+    double cost;            // of the face's best push so far; −∞ for a face around a seed vertex
+    std::uint32_t cluster;  // of that push
+    std::uint32_t label;    // the cluster that took the face, or invalid_id
+  };
   std::vector<grow_entry> grow_heap;
-  std::vector<dist_entry> dist_heap;
-  std::vector<double> dist;  // per face
-  std::vector<std::uint32_t> best_cluster;  // growth: cluster of a face's best push so far (uses dist for its cost)
-  std::vector<char> seed_face;              // growth: a face around its cluster's seed vertex
-  std::vector<char> is_seed;                // per vertex: chosen as a seed (seed selection)
+  std::vector<grow_state> grow;                     // growth: per face
+  std::vector<std::vector<dist_entry>> dist_heaps;  // re-seeding: one per cluster
+  std::vector<double> dist;                         // re-seeding: per face
+  std::vector<std::uint32_t> border_key, border_offsets, border;  // re-seeding: border faces by cluster
+  std::vector<char> is_seed;                        // per vertex: chosen as a seed (seed selection)
 };
 
 // Whether v can seed the next cluster, given the seeds already chosen (marked in is_seed): v is
@@ -187,7 +203,6 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
                           std::vector<std::uint32_t>& label) {
   using entry = clustering_workspace::grow_entry;
   const std::size_t nt = fd.area.size(), C = seeds.size();
-  label.assign(nt, invalid_id);
   std::vector<glm::dvec3> nsum(C, glm::dvec3(0.0));
   std::vector<double> ssum(C, 0.0), s0(C);
   std::vector<std::uint32_t> nfaces(C, 0);
@@ -202,12 +217,11 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
   };
   // A face is pushed only when (cost, cluster) beats its earlier pushes: a worse entry for the
   // same face would be popped after the better one, when the face is already labelled.
-  ws.dist.assign(nt, std::numeric_limits<double>::infinity());
-  ws.best_cluster.assign(nt, invalid_id);
-  ws.seed_face.assign(nt, 0);
+  auto& state = ws.grow;
+  state.assign(nt, {std::numeric_limits<double>::infinity(), invalid_id, invalid_id});
   auto push = [&](double cost, std::uint32_t c, std::uint32_t g) {
-    if (ws.seed_face[g] || cost > ws.dist[g] || (cost == ws.dist[g] && c >= ws.best_cluster[g])) return;
-    ws.dist[g] = cost, ws.best_cluster[g] = c;
+    if (cost > state[g].cost || (cost == state[g].cost && c >= state[g].cluster)) return;
+    state[g].cost = cost, state[g].cluster = c;
     heap.push_back({cost, -fd.hot[g].saliency, c, g});
     std::push_heap(heap.begin(), heap.end(), greater);
   };
@@ -220,14 +234,15 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
     }
   }
   for (std::uint32_t c = 0; c < C; ++c)  // from now on no growth takes a seed's face
-    for (std::uint32_t k = fd.vf_offsets[seeds[c]]; k < fd.vf_offsets[seeds[c] + 1]; ++k) ws.seed_face[fd.vf[k]] = 1;
+    for (std::uint32_t k = fd.vf_offsets[seeds[c]]; k < fd.vf_offsets[seeds[c] + 1]; ++k)
+      state[fd.vf[k]].cost = -std::numeric_limits<double>::infinity();
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), greater);
     const entry top = heap.back();
     heap.pop_back();
     const std::uint32_t c = top.cluster, f = top.face;
-    if (label[f] != invalid_id) continue;
-    label[f] = c;
+    if (state[f].label != invalid_id) continue;
+    state[f].label = c;
     if (nfaces[c] == 0) nsum[c] = glm::dvec3(0.0);  // from now on: the cluster's faces
     nsum[c] += fd.hot[f].normal * fd.area[f];
     ssum[c] += fd.hot[f].saliency;
@@ -237,7 +252,7 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
     const double mean_s = ssum[c] / nfaces[c];
     for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
       const std::uint32_t g = fd.nb[k];
-      if (label[g] != invalid_id) continue;
+      if (state[g].label != invalid_id) continue;
       const double sg = fd.hot[g].saliency;
       double step = std::max(0.0, (lambda_n - glm::dot(mean_n, fd.hot[g].normal)) *
                                       (std::abs(mean_s - sg) * std::abs(s0[c] - sg) * std::abs(fd.hot[f].saliency - sg)) *
@@ -249,6 +264,8 @@ inline void grow_clusters(const face_data& fd, std::span<const double> vsal, std
       push(top.cost + step, c, g);
     }
   }
+  label.resize(nt);
+  for (std::size_t f = 0; f < nt; ++f) label[f] = state[f].label;
 }
 
 // After a re-seeding search (distances in ws.dist): the best free corner of cluster c's faces in
@@ -268,44 +285,33 @@ std::uint32_t latest_free_seed(const M& m, const face_data& fd, std::span<const 
   return invalid_id;
 }
 
-// Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
-// Dijkstra search from the cluster's border faces inward (ties: original face index), among
-// the vertices that can seed it (can_seed; otherwise the faces reached before, latest first).
-template <class M>
-std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
-                                  std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
-                                  clustering_workspace& ws) {
+// Re-seeding's search for cluster c (eq. 3 costs): Dijkstra from its border faces
+// (ws.border_offsets/border) inward over its own faces; distances go to ws.dist (only c's
+// faces are written, so clusters may run concurrently, each with its own heap). Returns the
+// face popped last (the farthest; ties: original face index), or invalid_id without border.
+inline std::uint32_t farthest_from_border(const face_data& fd, std::span<const std::uint32_t> label, std::uint32_t c,
+                                          double smax, clustering_workspace& ws,
+                                          std::vector<clustering_workspace::dist_entry>& heap) {
   using entry = clustering_workspace::dist_entry;
-  const std::size_t nt = label.size(), C = old_seeds.size();
-  std::vector<double> smax(C, 0.0);
-  for (std::size_t f = 0; f < nt; ++f)
-    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.hot[f].saliency);
-  auto& heap = ws.dist_heap;
-  heap.clear();
   const auto greater = [&](const entry& x, const entry& y) {
     return x.dist != y.dist ? x.dist > y.dist : fd.original[x.face] > fd.original[y.face];
   };
-  ws.dist.assign(nt, std::numeric_limits<double>::infinity());
-  for (std::size_t f = 0; f < nt; ++f) {
-    if (label[f] >= C) continue;
-    bool border = fd.on_boundary[f] != 0;
-    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) border = border || label[fd.nb[k]] != label[f];
-    if (border) ws.dist[f] = 0.0, heap.push_back({0.0, static_cast<std::uint32_t>(f)});
-  }
+  heap.clear();
+  for (std::uint32_t k = ws.border_offsets[c]; k < ws.border_offsets[c + 1]; ++k)
+    ws.dist[ws.border[k]] = 0.0, heap.push_back({0.0, ws.border[k]});
   std::make_heap(heap.begin(), heap.end(), greater);
-  std::vector<std::uint32_t> last(C, invalid_id);
+  const double scale = smax > 0.0 ? 1.0 / smax : 0.0;
+  std::uint32_t last = invalid_id;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), greater);
     const auto [d, f] = heap.back();
     heap.pop_back();
     if (d > ws.dist[f]) continue;
-    const std::uint32_t c = label[f];
-    last[c] = f;  // popped in ascending distance: the final pop per cluster is the farthest
-    const double scale = smax[c] > 0.0 ? 1.0 / smax[c] : 0.0;
+    last = f;  // popped in ascending distance: the final pop is the farthest
     for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) {
       const std::uint32_t g = fd.nb[k];
       if (label[g] != c) continue;
-      const double step = fd.step_length[k] * (smax[c] > 0.0 ? fd.hot[g].saliency * scale : 1.0);
+      const double step = fd.step_length[k] * (smax > 0.0 ? fd.hot[g].saliency * scale : 1.0);
       if (d + step < ws.dist[g]) {
         ws.dist[g] = d + step;
         heap.push_back({d + step, g});
@@ -313,6 +319,46 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
       }
     }
   }
+  return last;
+}
+
+// Re-seeding (eq. 3): per cluster, the most salient vertex of the face reached last by a
+// Dijkstra search from the cluster's border faces inward (ties: original face index), among
+// the vertices that can seed it (can_seed; otherwise the faces reached before, latest first).
+// The clusters' searches run through exec, largest cluster first; the result does not depend
+// on the executor.
+template <class M, class E = serial_executor>
+std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<const std::uint32_t> label,
+                                  std::span<const double> vsal, std::span<const std::uint32_t> old_seeds,
+                                  clustering_workspace& ws, E&& exec = E{}) {
+  const std::size_t nt = label.size(), C = old_seeds.size();
+  std::vector<double> smax(C, 0.0);
+  std::vector<std::uint32_t> size(C, 0);
+  for (std::size_t f = 0; f < nt; ++f)
+    if (label[f] < C) smax[label[f]] = std::max(smax[label[f]], fd.hot[f].saliency), ++size[label[f]];
+  ws.dist.assign(nt, std::numeric_limits<double>::infinity());
+  // Border faces grouped by cluster: each cluster's search stays inside the cluster.
+  auto& border_key = ws.border_key;
+  border_key.assign(nt, no_bucket);
+  for (std::size_t f = 0; f < nt; ++f) {
+    if (label[f] >= C) continue;
+    bool is_border = fd.on_boundary[f] != 0;
+    for (std::uint32_t k = fd.nb_offsets[f]; k < fd.nb_offsets[f + 1]; ++k) is_border = is_border || label[fd.nb[k]] != label[f];
+    if (is_border) border_key[f] = label[f];
+  }
+  group_by_key(
+      C, nt, [&](std::size_t f) { return border_key[f]; }, [](std::size_t f) { return static_cast<std::uint32_t>(f); },
+      ws.border_offsets, ws.border);
+  std::vector<std::uint32_t> order(C), last(C, invalid_id);
+  for (std::uint32_t c = 0; c < C; ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] > size[b]; });
+  ws.dist_heaps.resize(C);
+  exec.parallel_for(C, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t c = order[i];
+      last[c] = farthest_from_border(fd, label, c, smax[c], ws, ws.dist_heaps[c]);
+    }
+  });
   std::vector<std::uint32_t> seeds(old_seeds.begin(), old_seeds.end());
   ws.is_seed.assign(fd.vf_offsets.size() - 1, 0);
   for (std::size_t c = 0; c < C; ++c) {
@@ -329,21 +375,46 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
   }
   return seeds;
 }
+
+// Radius √(area/π) of each of the C seeded clusters (label: per internal face). O(T).
+inline std::vector<double> cluster_radii(const face_data& fd, std::span<const std::uint32_t> label, std::size_t C) {
+  std::vector<double> area(C, 0.0);
+  for (std::size_t f = 0; f < label.size(); ++f)
+    if (label[f] < C) area[label[f]] += fd.area[f];
+  for (double& a : area) a = std::sqrt(a / std::numbers::pi);
+  return area;
+}
+
+// Whether each seed in `next` repeats the same cluster's seed in `earlier`: the same vertex, or,
+// with tolerance > 0, one within tolerance × radius[c] of it. O(C).
+template <class M>
+bool seeds_repeat(const M& m, std::span<const std::uint32_t> next, std::span<const std::uint32_t> earlier,
+                  std::span<const double> radius, double tolerance) {
+  for (std::size_t c = 0; c < next.size(); ++c) {
+    if (next[c] == earlier[c]) continue;
+    const glm::dvec3 d = glm::dvec3(mesh_position(m, next[c])) - glm::dvec3(mesh_position(m, earlier[c]));
+    if (!(tolerance > 0.0) || glm::length(d) > tolerance * radius[c]) return false;
+  }
+  return true;
+}
 }  // namespace detail
 
 // Salient clustering of a mesh from per-vertex saliency (saliency/mesh_saliency.hpp).
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
 // non-finite (non_finite) or negative (bad_parameter) saliency (names the vertex); clusters == 0
 // or more clusters than the pool or the triangle count can seed, or more than the mesh has room for (each seed needs a
-// face no other seed touches); pool_multiplier < 1; normal_weight < 1 (bad_parameter).
+// face no other seed touches); pool_multiplier < 1; normal_weight < 1; seed_tolerance negative or
+// not finite (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
-// reused by every round). Serial.
+// reused by every round). The growth is serial; re-seeding's per-cluster searches run through
+// exec (at most C at once), with the same result for every executor and thread count.
 // Pure: concurrent calls on the same mesh are safe.
-template <class M>
+template <class M, class E = serial_executor>
 result<salient_clusters> salient_clustering(const M& m, std::span<const double> saliency,
-                                            const salient_clustering_options& opt = {}) {
+                                            const salient_clustering_options& opt = {}, E&& exec = E{}) {
   static_assert(check_mesh<M>());
+  static_assert(check_executor<std::remove_cvref_t<E>>());
   if (status s = detail::check_indices_and_positions(m); !s.ok()) return s;
   const std::size_t nv = mesh_vertex_count(m), nt = mesh_triangle_count(m);
   if (saliency.size() != nv)
@@ -355,6 +426,8 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     return make_error(errc::bad_parameter, no_element, "pool_multiplier ", opt.pool_multiplier, " must be >= 1");
   if (!(opt.normal_weight >= 1.0) || !std::isfinite(opt.normal_weight))
     return make_error(errc::bad_parameter, no_element, "normal_weight ", opt.normal_weight, " must be >= 1");
+  if (!(opt.seed_tolerance >= 0.0) || !std::isfinite(opt.seed_tolerance))
+    return make_error(errc::bad_parameter, no_element, "seed_tolerance ", opt.seed_tolerance, " must be finite and >= 0");
   if (opt.clusters == 0 || opt.clusters > nt)
     return make_error(errc::bad_parameter, no_element, "clusters ", opt.clusters, " must be in [1, ", nt, "]");
   auto topo = make_topology(m);
@@ -404,8 +477,12 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     ++out.iterations;
     history.push_back(seeds);
     if (out.iterations >= opt.max_iterations) break;
-    auto next = detail::reseed(m, fd, label, saliency, seeds, ws);
-    const auto seen = std::find(history.begin(), history.end(), next);
+    auto next = detail::reseed(m, fd, label, saliency, seeds, ws, exec);
+    const std::vector<double> radius =
+        opt.seed_tolerance > 0.0 ? detail::cluster_radii(fd, label, seeds.size()) : std::vector<double>{};
+    const auto seen = std::find_if(history.begin(), history.end(), [&](const std::vector<std::uint32_t>& earlier) {
+      return detail::seeds_repeat(m, next, earlier, radius, opt.seed_tolerance);
+    });
     if (seen != history.end()) {
       out.converged = true;
       out.cycle = seen + 1 != history.end();
