@@ -382,8 +382,6 @@ std::vector<option_row> saliency_rows() {
        [](double x) { return run_salient_clustering({.seed = as_count<std::uint64_t>(x)}); }},
       {"salient_clustering", "max_iterations", false, u32_max, {},
        [](double x) { return run_salient_clustering({.max_iterations = as_count<std::uint32_t>(x)}); }},
-      {"salient_clustering", "seed_tolerance", true, 0, {},
-       [](double x) { return run_salient_clustering({.seed_tolerance = x}); }},
       {"estimate_view_importance", "camera", true, 0, {},
        [](double x) {
          const std::vector<double> s = bumpy_saliency(sphere());

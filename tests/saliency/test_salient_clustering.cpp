@@ -219,54 +219,6 @@ TEST_CASE("salient clustering: the flat tie-break on fandisk", "[mesh]") {
   CHECK(distance[1] < distance[0]);
 }
 
-TEST_CASE("salient clustering: seed_tolerance counts a seed near an earlier one as repeated") {
-  infolerp::indexed_mesh m;
-  m.positions = {{0, 0, 0}, {1, 0, 0}, {0.04f, 0, 0}, {0, 0, 0}, {0, 0.06f, 0}};
-  m.triangles = {{0, 1, 4}, {2, 1, 3}};
-  const std::vector<double> radius{1.0};
-  using infolerp::detail::seeds_repeat;
-  using seeds = std::vector<std::uint32_t>;
-  CHECK(seeds_repeat(m, seeds{0}, seeds{0}, radius, 0.0));       // the same vertex
-  CHECK_FALSE(seeds_repeat(m, seeds{3}, seeds{0}, radius, 0.0));  // another vertex at the same place
-  CHECK(seeds_repeat(m, seeds{2}, seeds{0}, radius, 0.05));       // 0.04 radius away
-  CHECK_FALSE(seeds_repeat(m, seeds{4}, seeds{0}, radius, 0.05));  // 0.06 radius away
-  CHECK(seeds_repeat(m, seeds{4}, seeds{0}, std::vector<double>{2.0}, 0.05));  // 0.03 of a larger cluster
-  CHECK_FALSE(seeds_repeat(m, seeds{0, 2}, seeds{0, 4}, std::vector<double>{1.0, 1.0}, 0.05));  // every seed must repeat
-
-  const auto sphere = infolerp::support::make_icosphere(1);
-  const std::vector<double> sal(sphere.positions.size(), 0.5);
-  for (double bad : {-0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
-    auto r = infolerp::salient_clustering(sphere, sal, {.clusters = 2, .seed_tolerance = bad});
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().code() == infolerp::errc::bad_parameter);
-    CHECK_THAT(r.error().message(), Catch::Contains("seed_tolerance"));
-  }
-}
-
-TEST_CASE("salient clustering: seed_tolerance cuts the exact test's rounds short on bunny00", "[mesh]") {
-  auto m = infolerp::support::load_mesh(infolerp::support::cgal_mesh("bunny00"));
-  if (!m.ok()) FAIL(m.error().message());
-  auto s = infolerp::compute_saliency(*m);
-  REQUIRE(s.ok());
-  // User seed 3: the exact test (the default) needs 17 rounds here, a tolerance of 5% of the
-  // cluster radius stops after 12.
-  infolerp::salient_clustering_options opt{.clusters = 10, .seed = 3};
-  auto exact = infolerp::salient_clustering(*m, s->saliency, opt);
-  auto near = infolerp::salient_clustering(*m, s->saliency, {.clusters = 10, .seed = 3, .seed_tolerance = 0.05});
-  REQUIRE(exact.ok());
-  REQUIRE(near.ok());
-  INFO("rounds: exact test " << exact->iterations << ", tolerance " << near->iterations);
-  CHECK(exact->converged);
-  CHECK(near->converged);
-  CHECK(near->iterations < exact->iterations);
-  // The same walk, stopped earlier: the exact test's clusters after as many rounds.
-  opt.max_iterations = near->iterations;
-  auto cut = infolerp::salient_clustering(*m, s->saliency, opt);
-  REQUIRE(cut.ok());
-  CHECK(cut->cluster == near->cluster);
-  CHECK(cut->seeds == near->seeds);
-}
-
 TEST_CASE("salient clustering: the same clusters for every executor and thread count") {
   const auto m = bumpy_sphere();
   auto s = infolerp::compute_saliency(m);

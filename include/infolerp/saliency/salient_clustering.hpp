@@ -11,30 +11,19 @@
 //        (λ_n − μ(n_c)·n_f') · |μ(S_c) − S_f'| · |S_c0 − S_f'| · |S_f − S_f'| · |x_f' − x_f|
 //      with μ(n_c) the cluster's area-weighted mean normal, μ(S_c) its mean face saliency and
 //      S_c0 its seed saliency, all as the cluster stands when f' is pushed.
-//      Eq. 2 is 0 whenever f and f' have equal saliency, so on a flat region (saliency exactly
-//      0 away from any feature) the paper's growth lets the first cluster to arrive take the
-//      whole region at no cost, however far it reaches. With flat_tie_break (the default, not in
-//      the paper) a step whose eq. 2 cost is 0 costs instead the mean cost per unit length of
-//      the non-zero steps pushed so far in this growth, times its length: flat regions are
-//      shared by distance. Every non-zero eq. 2 cost is kept as the paper gives it.
+//      Eq. 2 is 0 between faces of equal saliency, so on a flat region the first cluster to
+//      arrive takes it all. flat_tie_break (default, not in the paper) prices such a step at the
+//      mean cost per unit length of the growth's non-zero steps so far, times its length: flat
+//      regions are shared by distance; non-zero costs stay the paper's.
 //   3. Re-seeding: per cluster, a Dijkstra search from its border faces (faces next to another
 //      cluster or on a mesh boundary) inwards with cost |x_f' − x_f| · S_f' / max(S_c) (eq. 3);
 //      the new seed is the most salient vertex of the last face reached (a cluster without
 //      border keeps its seed).
-//   Seeds are distinct, and each seed has a face around it that no lower-numbered cluster's
-//   seed touches (a face around two seeds goes to the lower cluster): a vertex that fails this
-//   is skipped, in the draw for the next pool vertex, in re-seeding for the next most salient
-//   vertex of the last face, then of the faces reached before it. A seed's faces are not taken
-//   by another cluster's growth, so no seeded cluster ends empty.
-//   4. Repeat 2–3 until the seeds repeat a previous iteration's seeds (converged, or a cycle:
-//      the paper accepts any point on a cycle; we stop at the repeat) or max_iterations.
-//      The paper's test asks for the same vertices (seed_tolerance = 0, the default). With
-//      seed_tolerance > 0 (not in the paper) a seed also counts as repeated when it lies within
-//      seed_tolerance × its cluster's radius √(area/π) of that earlier seed: a test in units of
-//      the clusters, not of the mesh's resolution. The rounds wander before they repeat (each
-//      new seed is an argmax, so seeds jump), and how long is a matter of chance, not of the
-//      mesh's size; the tolerance stops the same walk at its first near-repeat (the result is
-//      the exact test's, cut short). Its effect on rounds and cluster quality: benchmarks/NOTES.md.
+//   Seeds are distinct and each keeps a face no lower-numbered cluster's seed touches (else the
+//   next candidate is taken: the next pool vertex, or the next vertex of the faces reached
+//   last); growth never takes a seed's faces, so no seeded cluster ends empty.
+//   4. Repeat 2–3 until the seeds repeat a previous iteration's (converged, or a cycle: the
+//      paper accepts any point on a cycle; we stop at the repeat) or max_iterations.
 // Face saliency S_f is the mean of its corners' vertex saliencies; x_f the centroid; n_f the
 // unit normal. Ties in every queue break by (cost, cluster, face), so the result is a function
 // of the mesh, the saliency and the seed only. Faces that no seed can reach (another connected
@@ -45,7 +34,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <numbers>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -70,7 +58,6 @@ struct salient_clustering_options {
   double normal_weight = 1.0;     // λ_n in eq. (2) (>= 1 keeps every cost non-negative)
   std::uint64_t seed = 1;         // user seed for drawing seeds from the pool
   std::uint32_t max_iterations = 50;  // growth + re-seeding rounds at most
-  double seed_tolerance = 0.0;    // seeds repeat within this × cluster radius (0: the same vertices)
   bool flat_tie_break = true;     // where eq. (2) costs 0, cost distance (see the top of this file)
 };
 
@@ -79,7 +66,7 @@ struct salient_clusters {
   std::vector<std::uint32_t> seeds;       // seed vertex of each seeded cluster (the last growth's)
   std::uint32_t count = 0;                // seeded clusters + extra ones for unreached components
   std::uint32_t iterations = 0;           // growth phases run
-  bool converged = false;                 // seeds repeated, within seed_tolerance (a fixed point or a cycle)
+  bool converged = false;                 // seeds repeated (a fixed point or a cycle)
   bool cycle = false;                     // the repeat was of an older iteration, not the last
 };
 
@@ -375,36 +362,13 @@ std::vector<std::uint32_t> reseed(const M& m, const face_data& fd, std::span<con
   }
   return seeds;
 }
-
-// Radius √(area/π) of each of the C seeded clusters (label: per internal face). O(T).
-inline std::vector<double> cluster_radii(const face_data& fd, std::span<const std::uint32_t> label, std::size_t C) {
-  std::vector<double> area(C, 0.0);
-  for (std::size_t f = 0; f < label.size(); ++f)
-    if (label[f] < C) area[label[f]] += fd.area[f];
-  for (double& a : area) a = std::sqrt(a / std::numbers::pi);
-  return area;
-}
-
-// Whether each seed in `next` repeats the same cluster's seed in `earlier`: the same vertex, or,
-// with tolerance > 0, one within tolerance × radius[c] of it. O(C).
-template <class M>
-bool seeds_repeat(const M& m, std::span<const std::uint32_t> next, std::span<const std::uint32_t> earlier,
-                  std::span<const double> radius, double tolerance) {
-  for (std::size_t c = 0; c < next.size(); ++c) {
-    if (next[c] == earlier[c]) continue;
-    const glm::dvec3 d = glm::dvec3(mesh_position(m, next[c])) - glm::dvec3(mesh_position(m, earlier[c]));
-    if (!(tolerance > 0.0) || glm::length(d) > tolerance * radius[c]) return false;
-  }
-  return true;
-}
 }  // namespace detail
 
 // Salient clustering of a mesh from per-vertex saliency (saliency/mesh_saliency.hpp).
 // Errors: mesh errors as mean_curvature; saliency.size() != vertex count (bad_size); a
 // non-finite (non_finite) or negative (bad_parameter) saliency (names the vertex); clusters == 0
 // or more clusters than the pool or the triangle count can seed, or more than the mesh has room for (each seed needs a
-// face no other seed touches); pool_multiplier < 1; normal_weight < 1; seed_tolerance negative or
-// not finite (bad_parameter).
+// face no other seed touches); pool_multiplier < 1; normal_weight < 1 (bad_parameter).
 // Complexity O(T log T) setup (faces are renumbered along a Morton curve for memory locality)
 // plus O(iterations · T log T); allocation O(T), made once (queues hold up to ~3T entries and are
 // reused by every round). The growth is serial; re-seeding's per-cluster searches run through
@@ -426,8 +390,6 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     return make_error(errc::bad_parameter, no_element, "pool_multiplier ", opt.pool_multiplier, " must be >= 1");
   if (!(opt.normal_weight >= 1.0) || !std::isfinite(opt.normal_weight))
     return make_error(errc::bad_parameter, no_element, "normal_weight ", opt.normal_weight, " must be >= 1");
-  if (!(opt.seed_tolerance >= 0.0) || !std::isfinite(opt.seed_tolerance))
-    return make_error(errc::bad_parameter, no_element, "seed_tolerance ", opt.seed_tolerance, " must be finite and >= 0");
   if (opt.clusters == 0 || opt.clusters > nt)
     return make_error(errc::bad_parameter, no_element, "clusters ", opt.clusters, " must be in [1, ", nt, "]");
   auto topo = make_topology(m);
@@ -478,11 +440,7 @@ result<salient_clusters> salient_clustering(const M& m, std::span<const double> 
     history.push_back(seeds);
     if (out.iterations >= opt.max_iterations) break;
     auto next = detail::reseed(m, fd, label, saliency, seeds, ws, exec);
-    const std::vector<double> radius =
-        opt.seed_tolerance > 0.0 ? detail::cluster_radii(fd, label, seeds.size()) : std::vector<double>{};
-    const auto seen = std::find_if(history.begin(), history.end(), [&](const std::vector<std::uint32_t>& earlier) {
-      return detail::seeds_repeat(m, next, earlier, radius, opt.seed_tolerance);
-    });
+    const auto seen = std::find(history.begin(), history.end(), next);
     if (seen != history.end()) {
       out.converged = true;
       out.cycle = seen + 1 != history.end();
