@@ -328,50 +328,40 @@ class subdivision_mesh {
   // pixel follows its leaf as it is split. Descends in double: weights lose no precision
   // relative to the input as the levels get deeper.
   [[nodiscard]] point_location locate_from(std::uint32_t t, glm::vec3 weights) const {
-    double w[3] = {weights.x, weights.y, weights.z};
+    // Three scalars, never an array indexed by a corner: the descent is a chain of dependent
+    // steps per pixel, and a spilled array would add a store-to-load round trip to each.
+    double w0 = weights.x, w1 = weights.y, w2 = weights.z;
     for (;;) {
       const subdivision_triangle& n = tris_[t];
-      if (n.retired) {  // lift the weights to the parent (see the children order)
-        const bool second = n.retired == 2;
-        const double wa = second ? 0.5 * w[0] : w[0] + 0.5 * w[1];
-        const double wb = second ? 0.5 * w[0] + w[1] : 0.5 * w[1];
-        const double wc = w[2];
-        const int k = n.split_edge;
-        w[k] = wa;
-        w[(k + 1) % 3] = wb;
-        w[(k + 2) % 3] = wc;
-        t = n.parent;
-        continue;
-      }
-      if (n.child_count == 0) break;
-      if (n.child_count == 4) {
-        int c = 3;
-        for (int i = 0; i < 3; ++i)
-          if (w[i] >= 0.5) c = i;
-        double cw[3];
-        if (c == 3) {
-          cw[0] = 1.0 - 2.0 * w[2];
-          cw[1] = 1.0 - 2.0 * w[0];
-          cw[2] = 1.0 - 2.0 * w[1];
-        } else {  // corner child c keeps corner c in slot c
-          for (int i = 0; i < 3; ++i) cw[i] = 2.0 * w[i];
-          cw[c] -= 1.0;
-        }
-        std::copy(cw, cw + 3, w);
-        t = n.first_child + static_cast<std::uint32_t>(c);
-      } else {
-        const int k = n.split_edge;
-        const double wa = w[k], wb = w[(k + 1) % 3], wc = w[(k + 2) % 3];
+      if (n.child_count == 4) {  // corner child c keeps corner c in slot c; the centre child is 3
+        const double a = 2.0 * w0, b = 2.0 * w1, c = 2.0 * w2;
+        std::uint32_t child = 3;
+        if (w2 >= 0.5) child = 2, w0 = a, w1 = b, w2 = c - 1.0;
+        else if (w1 >= 0.5) child = 1, w0 = a, w1 = b - 1.0, w2 = c;
+        else if (w0 >= 0.5) child = 0, w0 = a - 1.0, w1 = b, w2 = c;
+        else w0 = 1.0 - c, w1 = 1.0 - a, w2 = 1.0 - b;
+        t = n.first_child + child;
+      } else if (n.child_count == 2) {  // the bisected edge k runs from corner k to k + 1
+        double wa, wb, wc;
+        rotate_from(n.split_edge, w0, w1, w2, wa, wb, wc);
         if (wa >= wb) {
-          w[0] = wa - wb, w[1] = 2.0 * wb, w[2] = wc;
+          w0 = wa - wb, w1 = 2.0 * wb, w2 = wc;
           t = n.first_child;
         } else {
-          w[0] = 2.0 * wa, w[1] = wb - wa, w[2] = wc;
+          w0 = 2.0 * wa, w1 = wb - wa, w2 = wc;
           t = n.first_child + 1;
         }
+      } else if (n.retired) {  // lift the weights to the parent (see the children order)
+        const bool second = n.retired == 2;
+        const double wa = second ? 0.5 * w0 : w0 + 0.5 * w1;
+        const double wb = second ? 0.5 * w0 + w1 : 0.5 * w1;
+        rotate_to(n.split_edge, wa, wb, w2, w0, w1, w2);
+        t = n.parent;
+      } else {
+        break;
       }
     }
-    return {t, glm::vec3(static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2]))};
+    return {t, glm::vec3(static_cast<float>(w0), static_cast<float>(w1), static_cast<float>(w2))};
   }
 
   // Appends the ids of the current leaves, ascending. O(triangle_count()); allocation: growth of out.
@@ -484,6 +474,17 @@ class subdivision_mesh {
   }
 
  private:
+  // (a, b, c) = the weights of corners k, k + 1, k + 2 (mod 3); rotate_to is its inverse.
+  static void rotate_from(std::uint8_t k, double w0, double w1, double w2, double& a, double& b, double& c) noexcept {
+    if (k == 0) a = w0, b = w1, c = w2;
+    else if (k == 1) a = w1, b = w2, c = w0;
+    else a = w2, b = w0, c = w1;
+  }
+  static void rotate_to(std::uint8_t k, double a, double b, double c, double& w0, double& w1, double& w2) noexcept {
+    if (k == 0) w0 = a, w1 = b, w2 = c;
+    else if (k == 1) w1 = a, w2 = b, w0 = c;
+    else w2 = a, w0 = b, w1 = c;
+  }
   static constexpr std::uint32_t closure_only = std::numeric_limits<std::uint32_t>::max() / 2;
 
   // Barycentric weights of vertex v's position in original triangle t (least squares in the
