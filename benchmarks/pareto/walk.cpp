@@ -13,7 +13,7 @@
 // shader on the requested samples as shader_seconds: `simple` is the scene's Lambert with one
 // shadow ray, `reference` the demo's reference lighting (AO 64, soft shadow 16 rays). Before
 // each method's frame the same frame's primary rays are traced alone (same tracer, same
-// chunks) as primary_seconds. Serial executor, so all times share one core.
+// blocks of 256 rays) as primary_seconds. Serial executor, so all times share one core.
 //
 // CSV: method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches,
 // later_batch_seconds,later_batches (samples: newly shaded in the frame; psnr_db: the frame's
@@ -132,20 +132,21 @@ struct frame_row {
   std::size_t relocated_pixels = 0;  // pixels whose leaf a batch changed (counted untimed, on request)
 };
 
-// The frame's primary rays traced alone, as the agent traces them (rays made per chunk of the
-// agent's grain, one trace_intersect per chunk, serial): the floor of any agent that has to
-// know what each pixel sees.
-double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam, std::size_t grain) {
+// The frame's primary rays traced alone, as the agent traces them (made and traced in blocks of
+// 256 rays, serial): the floor of any agent that has to know what each pixel sees.
+double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam) {
+  constexpr std::size_t block = 256;
   const auto t = clock_type::now();
   const std::size_t n = std::size_t(cam.width) * cam.height;
   std::vector<infolerp::hit> hits(n);
-  std::vector<infolerp::ray> rays;
-  for (std::size_t begin = 0; begin < n; begin += grain) {
-    const std::size_t end = std::min(n, begin + grain);
-    rays.resize(end - begin);
-    for (std::size_t p = begin; p < end; ++p)
-      rays[p - begin] = cam.primary_ray(static_cast<std::uint32_t>(p % cam.width), static_cast<std::uint32_t>(p / cam.width));
-    infolerp::trace_intersect(*sc.tracer, std::span<const infolerp::ray>(rays), std::span<infolerp::hit>(hits.data() + begin, end - begin));
+  std::vector<infolerp::ray> rays(block);
+  for (std::size_t begin = 0; begin < n; begin += block) {
+    const std::size_t m = std::min(block, n - begin);
+    for (std::size_t i = 0; i < m; ++i)
+      rays[i] = cam.primary_ray(static_cast<std::uint32_t>((begin + i) % cam.width),
+                                static_cast<std::uint32_t>((begin + i) / cam.width));
+    infolerp::trace_intersect(*sc.tracer, std::span<const infolerp::ray>(rays.data(), m),
+                              std::span<infolerp::hit>(hits.data() + begin, m));
   }
   const double s = seconds_since(t);
   std::size_t valid = 0;  // keeps the trace observable
@@ -159,7 +160,7 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
                      bool restart, const std::vector<glm::vec3>& reference, const shade_fn& shade, bool count_relocated) {
   infolerp::serial_executor ex;
   frame_row row;
-  row.primary = primary_rays_seconds(sc, cam, infolerp::driver_options{}.grain);
+  row.primary = primary_rays_seconds(sc, cam);
   const std::size_t before = restart ? 0 : agent.samples_delivered();
   auto t = clock_type::now();
   if (auto st = restart ? agent.start(*sc.tracer, cam, ex) : agent.set_view(*sc.tracer, cam, ex); !st) {

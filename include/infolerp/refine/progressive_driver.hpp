@@ -38,6 +38,7 @@
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -468,6 +469,7 @@ class progressive_refiner {
   }
 
  private:
+  static constexpr std::size_t primary_block = 256;  // primary rays made and traced together
   enum : std::uint8_t { unshaded = 0, requested = 1, shaded = 2, delivering = 3 };
   static constexpr std::size_t no_index = std::numeric_limits<std::size_t>::max();
 
@@ -522,12 +524,15 @@ class progressive_refiner {
     if (auto st = check_camera(camera); !st) return st;
     const std::uint32_t width = camera.width;
     const std::size_t n = std::size_t(width) * camera.height;
-    hits.assign(n, hit{});
+    hits.resize(n);
     for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::vector<ray> rays(end - begin);
-      for (std::size_t p = begin; p < end; ++p)
-        rays[p - begin] = camera.primary_ray(static_cast<std::uint32_t>(p % width), static_cast<std::uint32_t>(p / width));
-      trace_intersect(tracer, std::span<const ray>(rays), std::span<hit>(hits.data() + begin, end - begin));
+      std::array<ray, primary_block> rays;  // on the stack: no allocation per chunk
+      for (std::size_t b = begin; b < end; b += primary_block) {
+        const std::size_t m = std::min(primary_block, end - b);
+        for (std::size_t i = 0; i < m; ++i)
+          rays[i] = camera.primary_ray(static_cast<std::uint32_t>((b + i) % width), static_cast<std::uint32_t>((b + i) / width));
+        trace_intersect(tracer, std::span<const ray>(rays.data(), m), std::span<hit>(hits.data() + b, m));
+      }
     });
     for (std::size_t p = 0; p < n; ++p) {
       const hit& h = hits[p];
@@ -591,15 +596,6 @@ class progressive_refiner {
     started_ = began;
     width_ = camera.width;
     height_ = camera.height;
-    const std::size_t n = hits.size();
-    pixel_leaf_.assign(n, invalid_id);
-    pixel_weights_.assign(n, glm::vec3(0.0f));
-    for (std::size_t p = 0; p < n; ++p) {
-      if (!hits[p].valid()) continue;
-      pixel_leaf_[p] = hits[p].triangle;
-      const glm::vec2 b = hits[p].barycentric;
-      pixel_weights_[p] = glm::vec3(1.0f - b.x - b.y, b.x, b.y);
-    }
     finished_ = false;
     stage1_recorded_ = false;
     view_requests_ = 0;
@@ -607,7 +603,7 @@ class progressive_refiner {
     state_.exhausted = false;
     report_ = {};
     sent_total_ = 0;
-    view_leaves(exec);
+    view_leaves(hits, exec);
   }
 
   [[nodiscard]] bool done() const {
@@ -731,14 +727,19 @@ class progressive_refiner {
   // leaf; the previous view's lists are dropped through its visible leaves, so the hierarchy
   // outside both views costs nothing. O(pixels · level + previous visible).
   template <class E>
-  void view_leaves(E&& exec) {
+  void view_leaves(const std::vector<hit>& hits, E&& exec) {
     for (std::uint32_t t : visible_.unordered()) leaf_pixels_[t] = 0, leaf_head_[t] = invalid_id;
-    const std::size_t n = pixel_leaf_.size();
+    const std::size_t n = hits.size();
+    pixel_leaf_.resize(n);
+    pixel_weights_.resize(n);
     exec.parallel_for(n, options_.grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t p = begin; p < end; ++p) {
-        const std::uint32_t leaf = pixel_leaf_[p];
-        if (leaf == invalid_id || mesh_.is_leaf(leaf)) continue;
-        const point_location loc = mesh_.locate_from(leaf, pixel_weights_[p]);
+        const hit& h = hits[p];
+        point_location loc;  // a miss: no leaf
+        if (h.valid()) {
+          const glm::vec3 w(1.0f - h.barycentric.x - h.barycentric.y, h.barycentric.x, h.barycentric.y);
+          loc = mesh_.is_leaf(h.triangle) ? point_location{h.triangle, w} : mesh_.locate_from(h.triangle, w);
+        }
         pixel_leaf_[p] = loc.leaf;
         pixel_weights_[p] = loc.weights;
       }

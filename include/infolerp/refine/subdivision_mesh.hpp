@@ -335,11 +335,11 @@ class subdivision_mesh {
       const subdivision_triangle& n = tris_[t];
       if (n.child_count == 4) {  // corner child c keeps corner c in slot c; the centre child is 3
         const double a = 2.0 * w0, b = 2.0 * w1, c = 2.0 * w2;
-        std::uint32_t child = 3;
-        if (w2 >= 0.5) child = 2, w0 = a, w1 = b, w2 = c - 1.0;
-        else if (w1 >= 0.5) child = 1, w0 = a, w1 = b - 1.0, w2 = c;
-        else if (w0 >= 0.5) child = 0, w0 = a - 1.0, w1 = b, w2 = c;
-        else w0 = 1.0 - c, w1 = 1.0 - a, w2 = 1.0 - b;
+        const std::uint32_t child = w2 >= 0.5 ? 2 : w1 >= 0.5 ? 1 : w0 >= 0.5 ? 0 : 3;
+        const bool centre = child == 3;  // selects, not branches: the child is a coin toss per pixel
+        w0 = centre ? 1.0 - c : child == 0 ? a - 1.0 : a;
+        w1 = centre ? 1.0 - a : child == 1 ? b - 1.0 : b;
+        w2 = centre ? 1.0 - b : child == 2 ? c - 1.0 : c;
         t = n.first_child + child;
       } else if (n.child_count == 2) {  // the bisected edge k runs from corner k to k + 1
         double wa, wb, wc;
