@@ -21,9 +21,14 @@ namespace {
 
 constexpr std::uint32_t W = 64, H = 48, FRAMES = 12;
 
+// Checked once, by the thread that builds it: shaders call scene() from worker threads, and
+// Catch2's assertions must not run concurrently.
 const support::walkthrough_scene& scene() {
-  static auto s = support::make_walkthrough_scene();
-  REQUIRE(s.ok());
+  static const auto s = [] {
+    auto built = support::make_walkthrough_scene();
+    REQUIRE(built.ok());
+    return built;
+  }();
   return *s;
 }
 
