@@ -736,10 +736,8 @@ class progressive_refiner {
       for (std::size_t p = begin; p < end; ++p) {
         const hit& h = hits[p];
         point_location loc;  // a miss: no leaf
-        if (h.valid()) {
-          const glm::vec3 w(1.0f - h.barycentric.x - h.barycentric.y, h.barycentric.x, h.barycentric.y);
-          loc = mesh_.is_leaf(h.triangle) ? point_location{h.triangle, w} : mesh_.locate_from(h.triangle, w);
-        }
+        const glm::vec2 b = h.barycentric;
+        if (h.valid()) loc = mesh_.locate_from(h.triangle, glm::vec3(1.0f - b.x - b.y, b.x, b.y));  // a leaf returns at once
         pixel_leaf_[p] = loc.leaf;
         pixel_weights_[p] = loc.weights;
       }
