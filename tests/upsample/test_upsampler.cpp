@@ -538,11 +538,12 @@ TEST_CASE("with probes: the cheap part is exact everywhere, the expensive part e
 // bit-identical, and a kept upsampler renders again without allocating. `after_serial(serial)`
 // adds the caller's checks on the serial frame.
 template <class Src, class F>
-void check_probe_frames_bit_identical(const Src& src, F&& after_serial) {
+void check_probe_frames_bit_identical(const Src& src, F&& after_serial, bool probe_every_sample = true) {
   const std::uint32_t w = 257, h = 190;
   for (std::uint32_t min_sources : {1u, 2u}) {
     auto make_probe = [&] {
-      auto u = infolerp::upsampler<sample>::create(w, h, {.passes = 4, .max_passes = 4, .min_sources = min_sources});
+      auto u = infolerp::upsampler<sample>::create(
+          w, h, {.passes = 4, .max_passes = 4, .min_sources = min_sources, .probe_every_sample = probe_every_sample});
       REQUIRE(u.ok());
       return std::move(*u);
     };
@@ -654,6 +655,83 @@ TEST_CASE("refined probes: a shadow between two agreeing sources is interpolated
 TEST_CASE("refined probes: serial and parallel outputs are bit-identical", "[upsample]") {
   refining<wavy> src;
   check_probe_frames_bit_identical(src, [&](const auto&) { CHECK(src.refinements.load() > 0); });
+}
+
+TEST_CASE("probes only where sources differ: none on one cluster, exact primary parts, fewer probes and evaluations", "[upsample]") {
+  for (bool edges : {false, true}) {
+    INFO("cluster and shadow edges " << edges);
+    refining<region_source> src;
+    src.inner.cluster_edge = edges;
+    src.inner.shadow_edge = edges;
+    src.inner.background_edge = edges;
+    const std::uint32_t w = 150, h = 333;
+    for (std::uint32_t min_sources : {1u, 2u})
+      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+        INFO("passes " << passes << " min_sources " << min_sources);
+        auto render = [&](bool every, std::vector<glm::vec4>& out) {
+          auto u = infolerp::upsampler<sample>::create(
+              w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true, .min_sources = min_sources,
+                     .probe_every_sample = every});
+          REQUIRE(u.ok());
+          src.probes = 0;
+          out = poisoned<region_source>(w, h);
+          REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+          return std::move(*u);
+        };
+        std::vector<glm::vec4> out, out_every;
+        const auto every = render(true, out_every);
+        const std::uint32_t probes_every = src.probes.load();
+        const auto u = render(false, out);
+        const std::uint32_t probes = src.probes.load();
+        // Attributes linear in each convex region: interpolating within one is exact, so every
+        // primary part (light bits included) is exact whether it came from a probe or not.
+        const auto ib = u.ibuffer();
+        std::size_t wrong_primary = 0, unset = 0;
+        for (std::uint32_t y = 0; y < h; ++y)
+          for (std::uint32_t x = 0; x < w; ++x) {
+            const sample& s = ib[y * w + x];
+            wrong_primary += same_primary(s, src.inner.evaluate(x, y)) ? 0 : 1;
+            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
+          }
+        CHECK(wrong_primary == 0);
+        CHECK(unset == 0);
+        auto plain = make(w, h, passes);
+        REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out_every)).ok());
+        if (!edges) {  // one cluster: the plain frame, no probe at all
+          CHECK(probes == 0);
+          CHECK(std::memcmp(out.data(), out_every.data(), out.size() * sizeof(glm::vec4)) == 0);
+        } else {  // a probe per boundary sample, not per pixel; fewer evaluations than without probes
+          CHECK(probes > 0);
+          CHECK(probes * 10 < probes_every);
+          CHECK(u.stats().evaluated() < plain.stats().evaluated());
+        }
+        CHECK(u.stats().evaluated() <= plain.stats().evaluated());
+        CHECK(u.stats().interpolated() >= every.stats().interpolated());
+      }
+  }
+}
+
+TEST_CASE("probes only where sources differ: a feature between agreeing sources is missed, as without probes", "[upsample]") {
+  const std::uint32_t w = 17, h = 9;
+  probing<thin_line> src;
+  auto u = infolerp::upsampler<sample>::create(w, h, {.passes = 2, .max_passes = 2, .keep_ibuffer = true,
+                                                      .probe_every_sample = false});
+  REQUIRE(u.ok());
+  std::vector<float> out(static_cast<std::size_t>(w) * h, -1.0f);
+  REQUIRE(u->render(src, std::span<float>(out)).ok());
+  for (std::uint32_t y = 0; y < h; ++y) {
+    INFO("row " << y);
+    CHECK(u->ibuffer()[y * w + 5].cluster == 0u);  // the column's sources (x = 4, 6) agree
+    CHECK(out[y * w + 5] == 1.0f);
+    CHECK(u->kinds()[y * w + 5] == sample_kind::interpolated);
+  }
+}
+
+TEST_CASE("probes only where sources differ: serial and parallel outputs are bit-identical", "[upsample]") {
+  refining<wavy> src;
+  check_probe_frames_bit_identical(
+      src, [&](const auto& serial) { CHECK(serial.stats().evaluated() > serial.stats().pass[0].evaluated); }, false);
+  CHECK(src.probes.load() > 0);
 }
 
 TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in perspective", "[upsample]") {

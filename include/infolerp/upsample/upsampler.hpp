@@ -58,6 +58,9 @@ struct upsampler_options {
                                     // probe that it is interpolated from (1 or 2; else it is evaluated). 1 only
                                     // for probes that carry all compatible() tests: one source cannot be
                                     // checked against another
+  bool probe_every_sample = true;   // sources with probes only: probe every new sample; false: probe only where
+                                    // the paper's test between its sources fails (elsewhere interpolate as
+                                    // without probes), a probe per boundary sample instead of per pixel
 };
 
 // Statistics of one pass.
@@ -326,43 +329,43 @@ class upsampler {
                     std::array<std::size_t, 3>& counts) {
     const std::uint32_t w = extents_[d][0];
     const std::uint32_t pw = extents_[d + 1][0];
-    const Sample* prev = levels_[d + 1].data();
-    const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;            // previous row at or above
-    const Sample* r1 = (j & 1u) ? r0 + pw : r0;                               // previous row below (odd j)
+    const Sample* r0 = levels_[d + 1].data() + static_cast<std::size_t>(j / 2) * pw;  // previous row at or above
+    const Sample* r1 = (j & 1u) ? r0 + pw : r0;                                      // previous row below (odd j)
     for (std::uint32_t i = 0; i < w; ++i) {
-      const std::uint32_t a = i / 2;
-      if ((j & 1u) == 0) {
-        if ((i & 1u) == 0) {
-          store(src, d, i, j, Sample(r0[a]), sample_kind::reused, out, counts);
-        } else if (detail::may_interpolate(src, r0[a], r0[a + 1]) && detail::sources_agree(src, r0[a], r0[a + 1])) {
-          store(src, d, i, j, detail::source_interpolate(src, r0[a], r0[a + 1]), sample_kind::interpolated, out,
-                counts);
-        } else {
-          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
-        }
-      } else if ((i & 1u) == 0) {
-        if (detail::may_interpolate(src, r0[a], r1[a]) && detail::sources_agree(src, r0[a], r1[a])) {
-          store(src, d, i, j, detail::source_interpolate(src, r0[a], r1[a]), sample_kind::interpolated, out, counts);
-        } else {
-          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
-        }
-      } else {
-        const Sample& s00 = r0[a];
-        const Sample& s10 = r0[a + 1];
-        const Sample& s01 = r1[a];
-        const Sample& s11 = r1[a + 1];
-        if (detail::may_interpolate(src, s00, s10) && detail::may_interpolate(src, s00, s01) &&
-            detail::may_interpolate(src, s00, s11) && detail::sources_agree(src, s00, s10, s01, s11)) {
-          store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out,
-                counts);
-        } else {
-          store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
-        }
+      if ((j & 1u) == 0 && (i & 1u) == 0) {
+        store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
+      } else if (!interpolate_between(src, d, i, j, r0, r1, out, counts)) {
+        store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
       }
     }
   }
 
-  // Later passes with probes: R as above; every new sample probes its own pixel and is
+  // §4's test for the new sample (i, j): when its 2 (edge) or 4 (centre) previous-pass samples
+  // may be interpolated with each other (and agree), stores their interpolation and returns true.
+  template <class S, class Pixel>
+  bool interpolate_between(const S& src, std::uint32_t d, std::uint32_t i, std::uint32_t j, const Sample* r0,
+                           const Sample* r1, std::span<Pixel> out, std::array<std::size_t, 3>& counts) {
+    const std::uint32_t a = i / 2;
+    if ((j & 1u) == 0 || (i & 1u) == 0) {  // edge: horizontal on even rows, vertical on odd ones
+      const Sample& s0 = r0[a];
+      const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
+      if (!detail::may_interpolate(src, s0, s1) || !detail::sources_agree(src, s0, s1)) return false;
+      store(src, d, i, j, detail::source_interpolate(src, s0, s1), sample_kind::interpolated, out, counts);
+      return true;
+    }
+    const Sample& s00 = r0[a];
+    const Sample& s10 = r0[a + 1];
+    const Sample& s01 = r1[a];
+    const Sample& s11 = r1[a + 1];
+    if (!detail::may_interpolate(src, s00, s10) || !detail::may_interpolate(src, s00, s01) ||
+        !detail::may_interpolate(src, s00, s11) || !detail::sources_agree(src, s00, s10, s01, s11))
+      return false;
+    store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out, counts);
+    return true;
+  }
+
+  // Later passes with probes: R as above; every new sample (with probe_every_sample false, every
+  // one that fails interpolate_between) probes its own pixel and is
   // interpolated from the sources compatible with its probe (choose_sources). A source that
   // can refine its probes (refine_probe, sample_source.hpp) probes cheaply first and needs
   // sources that agree with each other and bracket the new sample (both of an edge; all four
@@ -388,6 +391,7 @@ class upsampler {
         store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
         continue;
       }
+      if (!options_.probe_every_sample && interpolate_between(src, d, i, j, r0, r1, out, counts)) continue;
       const std::uint32_t x = i << d, y = j << d;
       Sample p = src.probe(x, y);
       chosen k;
