@@ -270,6 +270,18 @@ class harness {
                           c->count(), min_sources, passes);
             if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources)) return 1;
           }
+      // The same, probing only the new samples whose sources differ (probe_every_sample = false).
+      for (const sup::scene_clustering* c : with)
+        for (std::uint32_t min_sources = 1; min_sources <= 2; ++min_sources)
+          for (std::uint32_t passes = 3; passes <= 6; ++passes) {
+            sup::demo_refining_probe_source src;
+            refining(src, c);
+            double f = 0;
+            char setting[160];
+            std::snprintf(setting, sizeof setting, "%s (%zu), probe where sources differ, sun where needed, min %u src, %u passes",
+                          c->name.c_str(), c->count(), min_sources, passes);
+            if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources, false)) return 1;
+          }
       // The same, evaluating where the chosen sources' AO or soft-shadow ratios differ by more
       // than a tolerance (agree(), sample_source.hpp): the demo clustering and one coarser (159 ids).
       with.assign({&features});
@@ -502,11 +514,12 @@ class harness {
 
   template <class Sample, class Source>
   bool run_upsampler(const Source& src, std::uint32_t passes, const std::string& method, const std::string& setting,
-                     double& evaluated_fraction, std::uint32_t min_sources = 2) {
+                     double& evaluated_fraction, std::uint32_t min_sources = 2, bool probe_every_sample = true) {
     if (!matches(setting)) return true;
     auto up = infolerp::upsampler<Sample>::create(static_cast<std::uint32_t>(w_), static_cast<std::uint32_t>(h_),
                                                   {.passes = passes, .max_passes = passes, .rows_per_task = 2,
-                                                   .record_kinds = false, .min_sources = min_sources});
+                                                   .record_kinds = false, .min_sources = min_sources,
+                                                   .probe_every_sample = probe_every_sample});
     if (!up) return fail(up.error().message()) == 0;
     sup::image img(w_, h_);
     stopwatch t;

@@ -16,7 +16,9 @@
 //   per_pixel_hand   the same with the hand-written demo source (support/demo_upsample.hpp)
 //   ibuffer          the ready source, K passes
 //   ibuffer_refine   the ready source with refined probes (primary ray per pixel, hard shadow where
-//                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1
+//                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1;
+//                    "probe where sources differ": probe_every_sample off, a probe only where the
+//                    sources of a new sample differ
 //   *_hand           the hand-written source in the same setting (the ready source's cost ratio)
 //   denoise_atrous   n AO + m soft-shadow rays per pixel and the edge-avoiding à-trous filter
 //                    (upsample_denoise.hpp); --csv FILE appends every row of both scenes to FILE,
@@ -100,10 +102,12 @@ std::function<double(sup::image&)> per_pixel(const Source& src, int threads) {
 }
 
 template <class Source>
-std::function<double(sup::image&)> ibuffer(const Source& src, std::uint32_t passes, std::uint32_t min_sources, int threads, int w, int h) {
+std::function<double(sup::image&)> ibuffer(const Source& src, std::uint32_t passes, std::uint32_t min_sources, int threads, int w, int h,
+                                          bool probe_every_sample = true) {
   auto up = infolerp::upsampler<sample>::create(static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h),
                                                 {.passes = passes, .max_passes = passes, .rows_per_task = 2,
-                                                 .record_kinds = false, .min_sources = min_sources});
+                                                 .record_kinds = false, .min_sources = min_sources,
+                                                 .probe_every_sample = probe_every_sample});
   if (!up) {
     std::fprintf(stderr, "infolerp_pareto upsample: %s\n", up.error().message().c_str());
     std::exit(1);
@@ -334,6 +338,9 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
     rows.push_back({"ibuffer", std::to_string(p) + " passes", ibuffer(*ready, p, 2, o.threads, o.width, o.height), {}});
   for (std::uint32_t p : {4u, 5u, 6u})
     rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src", ibuffer(*refine, p, 1, o.threads, o.width, o.height), {}});
+  for (std::uint32_t p : {3u, 4u, 5u, 6u})
+    rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ",
+                    ibuffer(*refine, p, 1, o.threads, o.width, o.height, false), {}});
   rows.push_back({"ibuffer_hand", "4 passes", ibuffer(hand, 4, 2, o.threads, o.width, o.height), {}});
   rows.push_back({"ibuffer_refine_hand", "5 passes, min 1 src", ibuffer(hand_refine, 5, 1, o.threads, o.width, o.height), {}});
   for (const auto& [n, m] : {std::pair{1u, 1u}, {2u, 1u}, {4u, 1u}, {4u, 2u}, {8u, 2u}, {16u, 4u}}) {

@@ -4,8 +4,8 @@
 //   - the trade-off runs: one frame at each of 2..5 passes (method "ibuffer-K"; one pass is
 //     plain per-pixel evaluation, i.e. the reference), and at 3..5 passes with probes (method
 //     "ibuffer-probe-K": a primary ray per pixel, the sun ray where needed, AO and soft shadow
-//     interpolated), each
-//     added to ctx.results;
+//     interpolated), and at 3..5 passes with those probes only where a new sample's sources
+//     differ (method "ibuffer-sparse-K"), each added to ctx.results;
 //   - the shown frame, at --passes K, or with --passes auto under the pass controller (§4.2,
 //     include/infolerp/upsample/pass_controller.hpp, default frame-time bounds 1/60..1/30 s,
 //     at most 4 passes): the reference render counts as its first, one-pass frame, then frames
@@ -128,21 +128,33 @@ inline bool stage_upsample(demo_context& ctx, const support::scene_clustering* c
       report(pu.error());
       return false;
     }
-    for (std::uint32_t p = probe_first; p <= tradeoff_last; ++p) {
-      status s = pu->set_passes(p);
-      if (s) s = pu->render(psrc, std::span<glm::vec3>(img.pixels), exec);
-      if (!s) {
-        report(s);
-        return false;
-      }
-      const auto& r = add_result(ctx, "ibuffer-probe-" + std::to_string(p),
-                                 std::to_string(p) + " passes, refined probes (primary per pixel, sun where needed), " + cluster_note,
-                                 pu->stats().seconds, pu->stats().evaluated_fraction(), img);
-      std::printf("%-16s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
-                  ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());
-      record_time(ctx, "I-Buffer row " + r.method, r.seconds);
-      frames += r.seconds;
+    // The same probes taken only where a new sample's sources differ (probe_every_sample off):
+    // a primary ray per boundary sample instead of per pixel ("ibuffer-sparse-K").
+    auto su = upsampler<support::demo_sample>::create(w, h, {.passes = probe_first, .max_passes = tradeoff_last,
+                                                             .record_kinds = false, .min_sources = probe_min_sources,
+                                                             .probe_every_sample = false});
+    if (!su) {
+      report(su.error());
+      return false;
     }
+    for (auto* u : {&*pu, &*su})
+      for (std::uint32_t p = probe_first; p <= tradeoff_last; ++p) {
+        status s = u->set_passes(p);
+        if (s) s = u->render(psrc, std::span<glm::vec3>(img.pixels), exec);
+        if (!s) {
+          report(s);
+          return false;
+        }
+        const bool every = u->options().probe_every_sample;
+        const auto& r = add_result(ctx, (every ? "ibuffer-probe-" : "ibuffer-sparse-") + std::to_string(p),
+                                   std::to_string(p) + " passes, refined probes (primary " +
+                                       (every ? "per pixel" : "where the sources differ") + ", sun where needed), " + cluster_note,
+                                   u->stats().seconds, u->stats().evaluated_fraction(), img);
+        std::printf("%-16s %6.3f s  x%.2f  PSNR %6.2f dB  evaluated %.2f%% (%s)\n", r.method.c_str(), r.seconds,
+                    ctx.reference_stats.seconds / r.seconds, r.psnr, 100.0 * r.evaluated, r.setting.c_str());
+        record_time(ctx, "I-Buffer row " + r.method, r.seconds);
+        frames += r.seconds;
+      }
   }
 
   std::string chosen;
