@@ -14,7 +14,9 @@
 // Probes (optional, sample_source.hpp): a source that can evaluate a sample's cheap primary hit
 // at every pixel gets the §4 test with the new sample's own cluster id; matching sources give
 // only the expensive terms (AO, soft shadows), otherwise the sample is evaluated. refine_probe
-// adds the hard-shadow rays only where the agreeing, bracketing sources do not suffice.
+// adds the hard-shadow rays only where the agreeing, bracketing sources do not suffice. With
+// probe_every_sample off, only the samples whose sources fail the §4 test are probed: a primary
+// ray per boundary sample rather than per pixel, at the plain I-Buffer's geometric accuracy.
 // Agreeing sources (optional, beyond the paper): with agree(a, b), a new sample is evaluated
 // unless every pair of its chosen sources agrees (all pairs: agreement is not transitive).
 //
