@@ -241,6 +241,29 @@ bool same_primary(const sample& a, const sample& b) {
          a.lights == b.lights;
 }
 
+// The region scene with all its boundaries, or none.
+void set_edges(region_source& r, bool edges) {
+  r.cluster_edge = edges;
+  r.shadow_edge = edges;
+  r.background_edge = edges;
+}
+
+// Over a w x h I-Buffer of the region scene: samples whose primary part (light bits included)
+// differs from an evaluation, and samples whose occlusion was never completed (NaN).
+struct primary_errors {
+  std::size_t wrong = 0, unset = 0;
+};
+primary_errors check_primary(std::span<const sample> ib, const region_source& r, std::uint32_t w, std::uint32_t h) {
+  primary_errors e;
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const sample& s = ib[y * w + x];
+      e.wrong += same_primary(s, r.evaluate(x, y)) ? 0 : 1;
+      e.unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
+    }
+  return e;
+}
+
 }  // namespace
 
 TEST_CASE("a single cluster with attributes linear in screen space reconstructs exactly", "[upsample]") {
@@ -496,9 +519,7 @@ TEST_CASE("with probes: the cheap part is exact everywhere, the expensive part e
   for (bool edges : {false, true}) {
     INFO("cluster and shadow edges " << edges);
     probing<region_source> src;
-    src.inner.cluster_edge = edges;
-    src.inner.shadow_edge = edges;
-    src.inner.background_edge = edges;
+    set_edges(src.inner, edges);
     const std::uint32_t w = 150, h = 333;
     for (std::uint32_t min_sources : {1u, 2u})
       for (std::uint32_t passes = 2; passes <= 5; ++passes) {
@@ -509,17 +530,12 @@ TEST_CASE("with probes: the cheap part is exact everywhere, the expensive part e
         auto out = poisoned<region_source>(w, h);
         REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
         const auto ib = u->ibuffer();
-        std::size_t wrong_primary = 0, wrong = 0, unset = 0;
+        const primary_errors e = check_primary(ib, src.inner, w, h);
+        CHECK(e.wrong == 0);
+        CHECK(e.unset == 0);
+        std::size_t wrong = 0;
         for (std::uint32_t y = 0; y < h; ++y)
-          for (std::uint32_t x = 0; x < w; ++x) {
-            const sample& s = ib[y * w + x];
-            const sample e = src.inner.evaluate(x, y);
-            wrong_primary += same_primary(s, e) ? 0 : 1;
-            wrong += same_bits(s, e) ? 0 : 1;
-            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
-          }
-        CHECK(wrong_primary == 0);
-        CHECK(unset == 0);
+          for (std::uint32_t x = 0; x < w; ++x) wrong += same_bits(ib[y * w + x], src.inner.evaluate(x, y)) ? 0 : 1;
         if (!edges) {
           CHECK(wrong == 0);
           CHECK(u->stats().evaluated() == u->stats().pass[0].evaluated);
@@ -582,11 +598,7 @@ TEST_CASE("refined probes: refined only where two agreeing sources do not suffic
     INFO("cluster and shadow edges " << edges);
     refining<region_source> src;
     probing<region_source> full;
-    for (auto* inner : {&src.inner, &full.inner}) {
-      inner->cluster_edge = edges;
-      inner->shadow_edge = edges;
-      inner->background_edge = edges;
-    }
+    for (auto* inner : {&src.inner, &full.inner}) set_edges(*inner, edges);
     const std::uint32_t w = 150, h = 333;
     for (std::uint32_t min_sources : {1u, 2u})
       for (std::uint32_t passes = 2; passes <= 5; ++passes) {
@@ -603,15 +615,9 @@ TEST_CASE("refined probes: refined only where two agreeing sources do not suffic
         auto out = poisoned<region_source>(w, h);
         REQUIRE(u.render(src, std::span<glm::vec4>(out)).ok());
         const auto ib = u.ibuffer();
-        std::size_t wrong_primary = 0, unset = 0;
-        for (std::uint32_t y = 0; y < h; ++y)
-          for (std::uint32_t x = 0; x < w; ++x) {
-            const sample& s = ib[y * w + x];
-            wrong_primary += same_primary(s, src.inner.evaluate(x, y)) ? 0 : 1;  // light bits included
-            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
-          }
-        CHECK(wrong_primary == 0);
-        CHECK(unset == 0);
+        const primary_errors e = check_primary(ib, src.inner, w, h);
+        CHECK(e.wrong == 0);
+        CHECK(e.unset == 0);
         CHECK(src.probes.load() > 0);
         if (!edges) CHECK(src.refinements.load() == 0);
         if (edges) {
@@ -661,9 +667,7 @@ TEST_CASE("probes only where sources differ: none on one cluster, exact primary 
   for (bool edges : {false, true}) {
     INFO("cluster and shadow edges " << edges);
     refining<region_source> src;
-    src.inner.cluster_edge = edges;
-    src.inner.shadow_edge = edges;
-    src.inner.background_edge = edges;
+    set_edges(src.inner, edges);
     const std::uint32_t w = 150, h = 333;
     for (std::uint32_t min_sources : {1u, 2u})
       for (std::uint32_t passes = 2; passes <= 5; ++passes) {
@@ -685,16 +689,9 @@ TEST_CASE("probes only where sources differ: none on one cluster, exact primary 
         const std::uint32_t probes = src.probes.load();
         // Attributes linear in each convex region: interpolating within one is exact, so every
         // primary part (light bits included) is exact whether it came from a probe or not.
-        const auto ib = u.ibuffer();
-        std::size_t wrong_primary = 0, unset = 0;
-        for (std::uint32_t y = 0; y < h; ++y)
-          for (std::uint32_t x = 0; x < w; ++x) {
-            const sample& s = ib[y * w + x];
-            wrong_primary += same_primary(s, src.inner.evaluate(x, y)) ? 0 : 1;
-            unset += std::isnan(s.occlusion[0]) || std::isnan(s.occlusion[1]) ? 1 : 0;
-          }
-        CHECK(wrong_primary == 0);
-        CHECK(unset == 0);
+        const primary_errors e = check_primary(u.ibuffer(), src.inner, w, h);
+        CHECK(e.wrong == 0);
+        CHECK(e.unset == 0);
         auto plain = make(w, h, passes);
         REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out_every)).ok());
         if (!edges) {  // one cluster: the plain frame, no probe at all
