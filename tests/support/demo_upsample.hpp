@@ -15,6 +15,7 @@
 //   cluster_by_normal   per object, face normals binned on a cube map (cells×cells per face),
 //                       split further at texcoord halves so that no cluster spans a UV seam.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -155,6 +156,19 @@ struct demo_probe_source : demo_ibuffer_source {
   demo_sample probe(std::uint32_t x, std::uint32_t y) const {
     std::uint64_t rays = 0;
     return from_inputs(primary->evaluate_pixel(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height, rays));
+  }
+  // The same for pixels (xs[k], y), the primary rays traced as the tracer's packets, 64 at a time.
+  void probe(std::uint32_t y, std::span<const std::uint32_t> xs, std::span<demo_sample> out) const {
+    std::array<ray, 64> rays;
+    std::array<hit, 64> hits;
+    std::uint64_t count = 0;
+    for (std::size_t base = 0; base < xs.size(); base += rays.size()) {
+      const std::size_t n = std::min(rays.size(), xs.size() - base);
+      for (std::size_t k = 0; k < n; ++k)
+        rays[k] = primary->primary_ray(static_cast<float>(xs[base + k]) + 0.5f, static_cast<float>(y) + 0.5f, width, height);
+      primary->scene().tracer.intersect(std::span<const ray>(rays.data(), n), std::span<hit>(hits.data(), n));
+      for (std::size_t k = 0; k < n; ++k) out[base + k] = from_inputs(primary->evaluate_hit(rays[k], hits[k], count));
+    }
   }
   bool probe_compatible(const demo_sample& p, const demo_sample& s) const {
     return probe_lights ? compatible(p, s) : p.cluster == s.cluster;

@@ -101,6 +101,22 @@ TEST_CASE("ray cast source: the demo's records and colours, bit for bit", "[upsa
     auto ready_refine = support::make_demo_ray_cast_source<probe_mode::refine>(shader, clusters, w, h);
     REQUIRE(ready_refine);
     CHECK(same_frame(frame(hand_refine, w, h, 3, 2), frame(*ready_refine, w, h, 3, 2)));
+    // Batched probes (the tracer's packets) give the records of single ones.
+    std::size_t batched = 0, differ = 0;
+    for (std::uint32_t y = 0; y < h; ++y) {
+      std::vector<std::uint32_t> xs;
+      for (std::uint32_t x = y % 3; x < w; x += 1 + y % 2) xs.push_back(x);  // strides 1 and 2, as the upsampler's rows
+      std::vector<support::demo_sample> a(xs.size()), b(xs.size());
+      ready_probe->probe(y, xs, a);
+      ready_refine->probe(y, xs, b);
+      for (std::size_t k = 0; k < xs.size(); ++k) {
+        differ += same_bits(a[k], ready_probe->probe(xs[k], y)) ? 0 : 1;
+        differ += same_bits(b[k], ready_refine->probe(xs[k], y)) ? 0 : 1;
+      }
+      batched += 2 * xs.size();
+    }
+    CHECK(batched > 3000);
+    CHECK(differ == 0);
     // And the upsampled frame is not the per-pixel one (the comparison above is not vacuous).
     CHECK(!same_frame(frame(*ready, w, h, 1, 2), frame(*ready, w, h, 3, 2)));
   }

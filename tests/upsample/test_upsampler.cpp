@@ -731,6 +731,49 @@ TEST_CASE("probes only where sources differ: serial and parallel outputs are bit
   CHECK(src.probes.load() > 0);
 }
 
+// Refined probes that also probe many pixels of a row in one call, counting the calls; checks
+// that each call's pixels are ascending (after the caller's checks, under a lock).
+template <class Inner>
+struct batching : refining<Inner> {
+  using refining<Inner>::probe;
+  mutable std::atomic<std::uint32_t> batches{0}, unordered{0};
+  void probe(std::uint32_t y, std::span<const std::uint32_t> xs, std::span<sample> out) const {
+    batches.fetch_add(1, std::memory_order_relaxed);
+    if (!std::is_sorted(xs.begin(), xs.end()) || xs.size() != out.size()) unordered.fetch_add(1, std::memory_order_relaxed);
+    for (std::size_t k = 0; k < xs.size(); ++k) out[k] = probe(xs[k], y);
+  }
+};
+
+TEST_CASE("batched probes: the frames of single probes, per pixel and where sources differ", "[upsample]") {
+  static_assert(infolerp::batch_probing_sample_source<batching<wavy>>);
+  static_assert(!infolerp::batch_probing_sample_source<refining<wavy>>);
+  const std::uint32_t w = 257, h = 190;
+  for (bool every : {true, false})
+    for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+      INFO("probe_every_sample " << every << " passes " << passes);
+      auto render = [&](const auto& src, std::vector<glm::vec4>& out) {
+        auto u = infolerp::upsampler<sample>::create(
+            w, h, {.passes = passes, .max_passes = passes, .min_sources = 1, .probe_every_sample = every});
+        REQUIRE(u.ok());
+        out.assign(static_cast<std::size_t>(w) * h, glm::vec4(-7.0f));
+        REQUIRE(u->render(src, std::span<glm::vec4>(out), infolerp::support::thread_pool_executor{3}).ok());
+        return std::vector<sample_kind>(u->kinds().begin(), u->kinds().end());
+      };
+      refining<wavy> one;
+      batching<wavy> many;
+      std::vector<glm::vec4> a, b;
+      const auto kinds_one = render(one, a);
+      const auto kinds_many = render(many, b);
+      CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec4)) == 0);
+      CHECK(kinds_one == kinds_many);
+      CHECK(many.probes.load() == one.probes.load());  // every probe went through a batch
+      CHECK(many.batches.load() > 0);
+      CHECK(many.batches.load() < many.probes.load());
+      CHECK(many.unordered.load() == 0);
+      CHECK(many.refinements.load() == one.refinements.load());
+    }
+}
+
 TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in perspective", "[upsample]") {
   auto max_error = [](const plane_view& src) {
     auto up = make(81, 61, 4);

@@ -162,6 +162,20 @@ class ray_cast_source {
   sample_type probe(std::uint32_t x, std::uint32_t y) const requires(Probes != probe_mode::none) {
     return trace(x, y, Probes == probe_mode::primary, false);
   }
+  // The probes of pixels (xs[k], y), their primary rays traced through the tracer's batch
+  // overload when it has one (e.g. Embree's 16-ray packets), 64 at a time on the stack. The same
+  // records as probe(x, y) when the batch overload returns the hits of single rays.
+  void probe(std::uint32_t y, std::span<const std::uint32_t> xs, std::span<sample_type> out) const
+    requires(Probes != probe_mode::none) {
+    std::array<ray, 64> rays;
+    std::array<hit, 64> hits;
+    for (std::size_t base = 0; base < xs.size(); base += rays.size()) {
+      const std::size_t n = std::min(rays.size(), xs.size() - base);
+      for (std::size_t k = 0; k < n; ++k) rays[k] = camera_(pixel(xs[base + k]), pixel(y));
+      trace_intersect(*tracer_, std::span<const ray>(rays.data(), n), std::span<hit>(hits.data(), n));
+      for (std::size_t k = 0; k < n; ++k) out[base + k] = terms(rays[k], hits[k], Probes == probe_mode::primary, false);
+    }
+  }
   bool probe_compatible(const sample_type& p, const sample_type& s) const requires(Probes != probe_mode::none) {
     return Probes == probe_mode::primary ? compatible(p, s) : p.cluster == s.cluster;
   }
@@ -207,7 +221,10 @@ class ray_cast_source {
   // Primary hit, then the terms asked for: hard-shadow bits, then soft shadow and AO.
   sample_type trace(std::uint32_t x, std::uint32_t y, bool hard, bool occlusion) const {
     const ray primary = camera_(pixel(x), pixel(y));
-    const hit h = tracer_->intersect(primary);
+    return terms(primary, tracer_->intersect(primary), hard, occlusion);
+  }
+  // The same from a primary ray already traced.
+  sample_type terms(const ray& primary, const hit& h, bool hard, bool occlusion) const {
     sample_type s;
     if (!h.valid() || !h.barycentric_inside()) return s;  // a hit outside its triangle: a miss
     glm::vec3 ng;

@@ -33,6 +33,9 @@
 //   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const   optional:
 //        adds what the probe left out so that compatible() holds as for a full evaluation; called
 //        only where the agreeing, bracketing sources do not suffice (upsampler.hpp)
+//   void probe(uint32_t y, std::span<const uint32_t> xs, std::span<sample_type> out) const
+//        optional: out[k] = probe(xs[k], y) for every k (xs ascending, out.size() == xs.size()),
+//        e.g. the primary rays of a row traced as packets; the upsampler then probes in batches
 //
 // Optionally, beyond the paper: bool agree(const sample_type& a, const sample_type& b) const
 // (member: a tolerance is the source's state), e.g. expensive terms within a tolerance
@@ -43,6 +46,7 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -263,6 +267,13 @@ template <class S>
 concept refining_sample_source = probing_sample_source<S> &&
     requires(const S& s, std::uint32_t x, const typename S::sample_type& p) {
       { s.refine_probe(p, x, x) } -> std::convertible_to<typename S::sample_type>;
+    };
+
+// A probing source that also probes many pixels of one row in a call (see the top of this file).
+template <class S>
+concept batch_probing_sample_source = probing_sample_source<S> &&
+    requires(const S& s, std::uint32_t y, std::span<const std::uint32_t> xs, std::span<typename S::sample_type> out) {
+      s.probe(y, xs, out);
     };
 
 // One readable message per missing piece instead of template noise.

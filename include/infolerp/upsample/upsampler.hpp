@@ -380,43 +380,66 @@ class upsampler {
                  std::array<std::size_t, 3>& counts) {
     const std::uint32_t w = extents_[d][0];
     const std::uint32_t pw = extents_[d + 1][0];
-    const bool single = options_.min_sources <= 1;
-    // Sources that match the probe match each other (compatible() is an equivalence), unless
-    // the probe is tested with a probe_compatible() that leaves something out.
-    constexpr bool cross_check = detail::member_probe_compatible<S> || detail::adl_probe_compatible<Sample>;
-    const auto probe_match = [&](const Sample& p, const Sample& s) { return detail::may_complete(src, p, s); };
-    const Sample* prev = levels_[d + 1].data();
-    const Sample* r0 = prev + static_cast<std::size_t>(j / 2) * pw;
+    const Sample* r0 = levels_[d + 1].data() + static_cast<std::size_t>(j / 2) * pw;
     const Sample* r1 = (j & 1u) ? r0 + pw : r0;
+    // The new samples to probe, gathered in blocks so that a batch-probing source traces them
+    // together (at most 4 KiB of samples on the stack).
+    constexpr std::size_t block = std::clamp<std::size_t>(4096 / sizeof(Sample), 1, 64);
+    std::array<std::uint32_t, block> xs;
+    std::array<Sample, block> probes;
+    std::size_t n = 0;
+    const auto flush = [&] {
+      const std::span<const std::uint32_t> pending(xs.data(), n);
+      if constexpr (batch_probing_sample_source<S>) {
+        src.probe(j << d, pending, std::span<Sample>(probes.data(), n));
+      } else {
+        for (std::size_t k = 0; k < n; ++k) probes[k] = src.probe(xs[k], j << d);
+      }
+      for (std::size_t k = 0; k < n; ++k) complete(src, d, xs[k] >> d, j, std::move(probes[k]), r0, r1, out, counts);
+      n = 0;
+    };
     for (std::uint32_t i = 0; i < w; ++i) {
       if ((j & 1u) == 0 && (i & 1u) == 0) {
         store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
         continue;
       }
       if (!options_.probe_every_sample && interpolate_between(src, d, i, j, r0, r1, out, counts)) continue;
-      const std::uint32_t x = i << d, y = j << d;
-      Sample p = src.probe(x, y);
-      chosen k;
-      if constexpr (refining_sample_source<S>) {
-        k = choose_sources(src, p, r0, r1, i, j, {.single = false, .cross = cross_check, .bracket = true}, probe_match);
-        if (k.n == 0) {
-          p = src.refine_probe(p, x, y);
-          const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
-          k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = false, .bracket = false}, full_match);
-        }
-      } else {
-        k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = cross_check, .bracket = false}, probe_match);
+      xs[n++] = i << d;
+      if (n == block) flush();
+    }
+    flush();
+  }
+
+  // The new sample (i, j) from its probe p: interpolated from the sources that complete it
+  // (choose_sources, refining the probe first where the source can and must), else evaluated.
+  template <class S, class Pixel>
+  void complete(const S& src, std::uint32_t d, std::uint32_t i, std::uint32_t j, Sample&& p, const Sample* r0,
+                const Sample* r1, std::span<Pixel> out, std::array<std::size_t, 3>& counts) {
+    const bool single = options_.min_sources <= 1;
+    // Sources that match the probe match each other (compatible() is an equivalence), unless
+    // the probe is tested with a probe_compatible() that leaves something out.
+    constexpr bool cross_check = detail::member_probe_compatible<S> || detail::adl_probe_compatible<Sample>;
+    const auto probe_match = [&](const Sample& q, const Sample& s) { return detail::may_complete(src, q, s); };
+    const std::uint32_t x = i << d, y = j << d;
+    chosen k;
+    if constexpr (refining_sample_source<S>) {
+      k = choose_sources(src, p, r0, r1, i, j, {.single = false, .cross = cross_check, .bracket = true}, probe_match);
+      if (k.n == 0) {
+        p = src.refine_probe(p, x, y);
+        const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
+        k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = false, .bracket = false}, full_match);
       }
-      if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
-                                 : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
-        store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
-      } else if (k.n == 4) {
-        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
-              sample_kind::interpolated, out, counts);
-      } else {
-        store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1]), sample_kind::interpolated, out,
-              counts);
-      }
+    } else {
+      k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = cross_check, .bracket = false}, probe_match);
+    }
+    if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
+                               : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
+      store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+    } else if (k.n == 4) {
+      store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
+            sample_kind::interpolated, out, counts);
+    } else {
+      store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1]), sample_kind::interpolated, out, counts);
     }
   }
 
