@@ -111,6 +111,6 @@ void BM_IBufferFrame_vs_PerPixel(benchmark::State& state) {
   state.counters["psnr_db"] = psnr ? *psnr : -1.0;
   state.counters["evaluated"] = up->stats().evaluated_fraction();
 }
-BENCHMARK(BM_IBufferFrame_vs_PerPixel)->Args({4, 1})->Args({5, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IBufferFrame_vs_PerPixel)->Args({4, 1})->Args({6, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -22,7 +22,9 @@
 //                     sample's own cluster id (min_sources 1 or 2); "sun where needed": probes of the
 //                     primary ray only, refined with the sun ray where two agreeing sources do not suffice;
 //                     "AO+soft within T": also evaluated unless the chosen sources' AO and soft-shadow
-//                     ratios differ pairwise by at most T (agree(), sample_source.hpp)
+//                     ratios differ pairwise by at most T (agree(), sample_source.hpp); "probe where
+//                     sources differ": probe_every_sample off, a probe only where a new sample's
+//                     sources differ (or their normals by more than an angle: smooth())
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
 //   denoise_atrous    what engines ship: primary + sun ray, n AO and m soft-shadow rays per pixel
@@ -282,6 +284,18 @@ class harness {
                           c->name.c_str(), c->count(), min_sources, passes);
             if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, min_sources, false)) return 1;
           }
+      // ... and also where the sources' normals differ by more than an angle (smooth()): the demo clustering.
+      for (float degrees : {10.0f, 5.0f, 2.5f})
+        for (std::uint32_t passes = 4; passes <= 6; ++passes) {
+          sup::demo_refining_probe_source src;
+          refining(src, &features);
+          src.smooth_cos = std::cos(degrees * 3.14159265f / 180.0f);
+          double f = 0;
+          char setting[160];
+          std::snprintf(setting, sizeof setting, "%s (%zu), probe where sources differ or normals > %.1f deg, sun where needed, min 1 src, %u passes",
+                        features.name.c_str(), features.count(), static_cast<double>(degrees), passes);
+          if (!run_upsampler<sample>(src, passes, "ibuffer_probe", setting, f, 1, false)) return 1;
+        }
       // The same, evaluating where the chosen sources' AO or soft-shadow ratios differ by more
       // than a tolerance (agree(), sample_source.hpp): the demo clustering and one coarser (159 ids).
       with.assign({&features});

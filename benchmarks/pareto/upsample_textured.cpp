@@ -18,7 +18,8 @@
 //   ibuffer_refine   the ready source with refined probes (primary ray per pixel, hard shadow where
 //                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1;
 //                    "probe where sources differ": probe_every_sample off, a probe only where the
-//                    sources of a new sample differ
+//                    sources of a new sample differ ("or normals > 5 deg": the ready source's
+//                    default smooth_angle; without it, smooth_angle infinite)
 //   *_hand           the hand-written source in the same setting (the ready source's cost ratio)
 //   denoise_atrous   n AO + m soft-shadow rays per pixel and the edge-avoiding à-trous filter
 //                    (upsample_denoise.hpp); --csv FILE appends every row of both scenes to FILE,
@@ -35,6 +36,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -323,7 +325,9 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
   const sup::reference_shader primary(scene, po);
   auto ready = sup::make_demo_ray_cast_source(shader, clusters, o.width, o.height);
   auto refine = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(shader, clusters, o.width, o.height);
-  if (!ready || !refine) return std::fprintf(stderr, "ray_cast_source failed\n"), 1;
+  auto refine_flat = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(
+      shader, clusters, o.width, o.height, true, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity());
+  if (!ready || !refine || !refine_flat) return std::fprintf(stderr, "ray_cast_source failed\n"), 1;
   const sup::demo_ibuffer_source hand{&shader, &clusters, o.width, o.height};
   sup::demo_refining_probe_source hand_refine;
   static_cast<sup::demo_ibuffer_source&>(hand_refine) = hand;
@@ -339,8 +343,11 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
   for (std::uint32_t p : {4u, 5u, 6u})
     rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src", ibuffer(*refine, p, 1, o.threads, o.width, o.height), {}});
   for (std::uint32_t p : {3u, 4u, 5u, 6u})
-    rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ",
+    rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ or normals > 5 deg",
                     ibuffer(*refine, p, 1, o.threads, o.width, o.height, false), {}});
+  for (std::uint32_t p : {4u, 5u, 6u})
+    rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ",
+                    ibuffer(*refine_flat, p, 1, o.threads, o.width, o.height, false), {}});
   rows.push_back({"ibuffer_hand", "4 passes", ibuffer(hand, 4, 2, o.threads, o.width, o.height), {}});
   rows.push_back({"ibuffer_refine_hand", "5 passes, min 1 src", ibuffer(hand_refine, 5, 1, o.threads, o.width, o.height), {}});
   for (const auto& [n, m] : {std::pair{1u, 1u}, {2u, 1u}, {4u, 1u}, {4u, 2u}, {8u, 2u}, {16u, 4u}}) {

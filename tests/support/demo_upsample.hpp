@@ -173,6 +173,9 @@ struct demo_probe_source : demo_ibuffer_source {
   bool probe_compatible(const demo_sample& p, const demo_sample& s) const {
     return probe_lights ? compatible(p, s) : p.cluster == s.cluster;
   }
+  // With probes only where sources differ: also where normals differ by more than acos(smooth_cos).
+  float smooth_cos = -1.0f;
+  bool smooth(const demo_sample& a, const demo_sample& b) const { return normals_within(a, b, smooth_cos); }
 };
 
 // The same with cheap probes and refinement (refine_probe, sample_source.hpp): probes trace
@@ -237,7 +240,8 @@ using demo_ray_cast_source = ray_cast_source<embree_scene, demo_camera, demo_geo
 template <probe_mode Probes = probe_mode::none>
 result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_shader& shader, const scene_clustering& clusters,
                                                                int width, int height, bool perspective = true,
-                                                               float tolerance = std::numeric_limits<float>::infinity()) {
+                                                               float tolerance = std::numeric_limits<float>::infinity(),
+                                                               float smooth_angle = ray_cast_options{}.smooth_angle) {
   const demo_scene& scene = shader.scene();
   const shader_options& so = shader.options();
   ray_cast_options o{.ao_rays = so.ao_rays, .ao_radius = scene.ao_radius, .ray_offset = scene.ray_offset};
@@ -253,6 +257,7 @@ result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_s
     o.view_forward = shader.camera_rays().forward;
   }
   o.tolerance = tolerance;
+  o.smooth_angle = smooth_angle;
   std::vector<std::span<const std::uint32_t>> ids(clusters.ids.begin(), clusters.ids.end());
   return demo_ray_cast_source<Probes>::create(scene.tracer, demo_camera{shader.camera_rays(), width, height},
                                               demo_geometry{&scene}, demo_material{&shader, &clusters}, std::move(ids),

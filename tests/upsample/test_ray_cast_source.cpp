@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <glm/gtc/matrix_transform.hpp>
 #include <span>
@@ -174,4 +175,26 @@ TEST_CASE("ray cast source: bad options are named", "[upsample][ray_cast_source]
   auto radius = source::create(tracer, camera, geometry, material, {}, {.ao_radius = -1.0f});
   REQUIRE(!radius);
   CHECK(radius.error().message().find("ao_radius") != std::string::npos);
+  for (float angle : {-0.1f, std::numeric_limits<float>::quiet_NaN()}) {
+    infolerp::ray_cast_options bad;
+    bad.smooth_angle = angle;
+    auto smooth = source::create(tracer, camera, geometry, material, {}, bad);
+    REQUIRE(!smooth);
+    CHECK(smooth.error().code() == infolerp::errc::bad_parameter);
+    CHECK(smooth.error().message().find("smooth_angle") != std::string::npos);
+  }
+  infolerp::ray_cast_options never;
+  never.smooth_angle = std::numeric_limits<float>::infinity();
+  auto ok = source::create(tracer, camera, geometry, material, {}, never);
+  REQUIRE(ok);
+  infolerp::surface_sample<2> a, b;
+  a.normal = {0.0f, 0.0f, 1.0f};
+  b.normal = {0.0f, 0.0f, -1.0f};
+  CHECK(ok->smooth(a, b));  // smooth_angle infinite: never probes for the normals
+  auto five = source::create(tracer, camera, geometry, material, {}, {});
+  REQUIRE(five);
+  b.normal = {std::sin(0.08f), 0.0f, std::cos(0.08f)};  // 4.6 degrees
+  CHECK(five->smooth(a, b));
+  b.normal = {std::sin(0.09f), 0.0f, std::cos(0.09f)};  // 5.2 degrees
+  CHECK(!five->smooth(a, b));
 }

@@ -774,6 +774,65 @@ TEST_CASE("batched probes: the frames of single probes, per pixel and where sour
     }
 }
 
+TEST_CASE("normals_within: the angle between normals of any length, both ways", "[upsample]") {
+  sample a, b;
+  a.normal = {2.0f, 0.0f, 0.0f};
+  b.normal = {0.5f, 0.5f, 0.0f};  // 45 degrees, neither unit
+  const auto deg = [](float d) { return std::cos(d * 3.14159265f / 180.0f); };
+  CHECK(infolerp::normals_within(a, b, deg(46.0f)));
+  CHECK(infolerp::normals_within(b, a, deg(46.0f)));
+  CHECK(!infolerp::normals_within(a, b, deg(44.0f)));
+  CHECK(!infolerp::normals_within(b, a, deg(44.0f)));
+  b.normal = {-1.0f, 0.01f, 0.0f};  // nearly opposite
+  CHECK(infolerp::normals_within(a, b, deg(179.9f)));
+  CHECK(!infolerp::normals_within(a, b, deg(178.0f)));
+  CHECK(infolerp::normals_within(a, b, -1.0f));
+  b.normal = glm::vec3(0.0f);  // no direction: only -1 accepts it
+  CHECK(!infolerp::normals_within(a, b, deg(179.0f)));
+  CHECK(infolerp::normals_within(a, b, -1.0f));
+  CHECK(infolerp::normals_within(a, a, 1.0f - 1e-6f));
+}
+
+// Refined probes with a smooth() that always answers `answer`, counting its calls.
+template <class Base>
+struct smoothing : Base {
+  bool answer = true;
+  mutable std::atomic<std::uint32_t> calls{0};
+  bool smooth(const sample&, const sample&) const {
+    calls.fetch_add(1, std::memory_order_relaxed);
+    return answer;
+  }
+};
+
+TEST_CASE("smooth(): never smooth probes every new sample, always smooth is the sparse frame", "[upsample]") {
+  const std::uint32_t w = 257, h = 190;
+  const auto render = [&](const auto& src, bool every, std::vector<glm::vec4>& out) {
+    auto u = infolerp::upsampler<sample>::create(
+        w, h, {.passes = 4, .max_passes = 4, .min_sources = 1, .probe_every_sample = every});
+    REQUIRE(u.ok());
+    out.assign(static_cast<std::size_t>(w) * h, glm::vec4(-7.0f));
+    REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+    return std::vector<sample_kind>(u->kinds().begin(), u->kinds().end());
+  };
+  refining<wavy> plain;
+  std::vector<glm::vec4> every, sparse, a, b;
+  const auto kinds_every = render(plain, true, every);
+  const auto kinds_sparse = render(plain, false, sparse);
+  REQUIRE(std::memcmp(every.data(), sparse.data(), every.size() * sizeof(glm::vec4)) != 0);
+  smoothing<refining<wavy>> never, always;
+  never.answer = false;
+  CHECK(render(never, false, a) == kinds_every);
+  CHECK(std::memcmp(a.data(), every.data(), a.size() * sizeof(glm::vec4)) == 0);
+  CHECK(render(always, false, b) == kinds_sparse);
+  CHECK(std::memcmp(b.data(), sparse.data(), b.size() * sizeof(glm::vec4)) == 0);
+  CHECK(never.calls.load() > 0);
+  CHECK(always.calls.load() > 0);
+  smoothing<refining<wavy>> unused;
+  unused.answer = false;
+  CHECK(render(unused, true, a) == kinds_every);  // with a probe per sample smooth() is not asked
+  CHECK(unused.calls.load() == 0);
+}
+
 TEST_CASE("inv_depth weights reconstruct attributes affine on a plane seen in perspective", "[upsample]") {
   auto max_error = [](const plane_view& src) {
     auto up = make(81, 61, 4);

@@ -20,7 +20,8 @@
 // the primary ray and the hard-shadow rays; probe_mode::refine probes trace the primary ray only
 // and refine_probe adds the hard-shadow rays where the upsampler needs them. agree() compares
 // the occlusion terms within options.tolerance (occlusion_within); the default, +infinity,
-// always agrees and gives the frame of a source without agree().
+// always agrees and gives the frame of a source without agree(). smooth() compares normals
+// within options.smooth_angle (normals_within), for probes only where sources differ.
 // The AO directions are a fixed cosine-weighted Hammersley set rotated into each hit's tangent
 // frame, and the soft-shadow points a fixed set the engine gives, so evaluating a pixel twice
 // gives the same bits (no Monte Carlo noise for the upsampler to smear).
@@ -64,6 +65,10 @@ struct ray_cast_options {
   glm::vec3 view_origin{0.0f};           // with view_forward != 0: inv_depth = 1 / view depth
   glm::vec3 view_forward{0.0f};          // (perspective-correct weights); 0: screen-linear
   float tolerance = std::numeric_limits<float>::infinity();  // agree(): occlusion terms within this
+  // smooth(), for probes only where sources differ (upsampler_options::probe_every_sample off):
+  // a sample is also probed where its sources' normals differ by more than this angle (radians;
+  // π or more: never), so that curved surfaces are not interpolated over coarse cells.
+  float smooth_angle = 5.0f * 3.14159265f / 180.0f;
 };
 
 enum class probe_mode : std::uint8_t { none, primary, refine };
@@ -118,7 +123,8 @@ class ray_cast_source {
   // clusters[g][t]: the cluster id of triangle t of geometry g; the arrays must cover every
   // triangle a primary ray can hit (unchecked). The tracer must outlive the source.
   // Errors: more than 32 lights, ao_rays above 65,536, a non-finite or negative ao_radius or
-  // ray_offset, a non-finite view_origin or view_forward (bad_parameter); a NaN or infinite
+  // ray_offset, a NaN or negative smooth_angle, a non-finite view_origin or view_forward
+  // (bad_parameter); a NaN or infinite
   // vertex normal or texcoord of geometry g < clusters.size() (non_finite, names the vertex or
   // triangle); texcoords of the library's adaptors present but not 3 per triangle (bad_size).
   // Zero normals are accepted: where the interpolated normal has no direction the geometric
@@ -137,6 +143,8 @@ class ray_cast_source {
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ao_radius must be finite and >= 0");
     if (!(options.ray_offset >= 0.0f) || !std::isfinite(options.ray_offset))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: ray_offset must be finite and >= 0");
+    if (!(options.smooth_angle >= 0.0f))
+      return make_error(errc::bad_parameter, no_element, "ray_cast_source: smooth_angle must be >= 0 (radians)");
     if (!all_finite(options.view_origin) || !all_finite(options.view_forward))
       return make_error(errc::bad_parameter, no_element, "ray_cast_source: view_origin and view_forward must be finite");
     for (std::uint32_t g = 0; g < clusters.size(); ++g)
@@ -184,6 +192,7 @@ class ray_cast_source {
     return trace(x, y, true, false);
   }
   bool agree(const sample_type& a, const sample_type& b) const { return occlusion_within(a, b, options_.tolerance); }
+  bool smooth(const sample_type& a, const sample_type& b) const { return normals_within(a, b, smooth_cos_); }
 
   const ray_cast_options& options() const { return options_; }
   // The most rays one evaluate() traces: 1 + lights + soft-shadow points + AO rays.
@@ -193,7 +202,8 @@ class ray_cast_source {
   ray_cast_source(const Tracer& tracer, Camera camera, Geometry geometry, Material material,
                   std::vector<std::span<const std::uint32_t>> clusters, ray_cast_options options)
       : tracer_(&tracer), camera_(std::move(camera)), geometry_(std::move(geometry)), material_(std::move(material)),
-        clusters_(std::move(clusters)), options_(std::move(options)), hemisphere_(cosine_hemisphere(options_.ao_rays)) {}
+        clusters_(std::move(clusters)), options_(std::move(options)), hemisphere_(cosine_hemisphere(options_.ao_rays)),
+        smooth_cos_(options_.smooth_angle >= 3.14159265f ? -1.0f : std::cos(options_.smooth_angle)) {}
 
   static float pixel(std::uint32_t i) { return static_cast<float>(i) + 0.5f; }
   // Normals and texcoords that surface() reads: finite, and texcoords of the adaptors whole.
@@ -343,6 +353,7 @@ class ray_cast_source {
   std::vector<std::span<const std::uint32_t>> clusters_;
   ray_cast_options options_;
   std::vector<glm::vec3> hemisphere_;
+  float smooth_cos_;  // cos(smooth_angle), -1 for π and above
 };
 
 }  // namespace infolerp

@@ -37,17 +37,24 @@
 //        optional: out[k] = probe(xs[k], y) for every k (xs ascending, out.size() == xs.size()),
 //        e.g. the primary rays of a row traced as packets; the upsampler then probes in batches
 //
+// Optionally, for probes only where sources differ (upsampler_options::probe_every_sample off):
+// bool smooth(const sample_type& a, const sample_type& b) const, whether a sample between a and
+// b may take its geometry (position, normal, texcoords) from them without a probe, e.g. normals
+// within an angle (normals_within below); where not, it is probed. Symmetric, thread-safe and
+// deterministic like compatible().
 // Optionally, beyond the paper: bool agree(const sample_type& a, const sample_type& b) const
 // (member: a tolerance is the source's state), e.g. expensive terms within a tolerance
 // (occlusion_within below); a new sample is evaluated unless every pair of its sources agrees.
 // Symmetric, thread-safe and deterministic like compatible(), need not be transitive. A source
 // that always agrees gives exactly the frame of one without agree().
 #include <array>
+#include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <type_traits>
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/status.hpp"
@@ -150,6 +157,19 @@ template <std::size_t K, bool L>
   return true;
 }
 
+// Whether the normals of a and b (unit or not) make an angle whose cosine is at least
+// `min_cos` (-1 or below: always); otherwise false when either normal is zero. A source's
+// smooth() for the default record. O(1).
+template <std::size_t K, bool L>
+[[nodiscard]] inline bool normals_within(const surface_sample<K, L>& a, const surface_sample<K, L>& b,
+                                         float min_cos) noexcept {
+  if (min_cos <= -1.0f) return true;
+  // dot >= min_cos·|a|·|b| without a square root: x·|x| is increasing, so square both sides that way.
+  const float dot = glm::dot(a.normal, b.normal);
+  const float norms2 = glm::dot(a.normal, a.normal) * glm::dot(b.normal, b.normal);
+  return norms2 > 0.0f && dot * std::abs(dot) >= min_cos * std::abs(min_cos) * norms2;
+}
+
 namespace detail {
 // The primary-hit part of a probe (member by member, see above).
 template <std::size_t K, bool L>
@@ -230,6 +250,10 @@ concept adl_probe_compatible = requires(const T& a) {
 template <class S>
 concept member_agree = requires(const S& s, const sample_of<S>& a) {
   { s.agree(a, a) } -> std::convertible_to<bool>;
+};
+template <class S>
+concept member_smooth = requires(const S& s, const sample_of<S>& a) {
+  { s.smooth(a, a) } -> std::convertible_to<bool>;
 };
 template <class T>
 concept adl_compatible = requires(const T& a) {
@@ -326,6 +350,21 @@ template <class S>
                                         const sample_of<S>& d) {
   return sources_agree(s, a, b) && sources_agree(s, a, c) && sources_agree(s, a, d) && sources_agree(s, b, c) &&
          sources_agree(s, b, d) && sources_agree(s, c, d);
+}
+// Whether the sources of one interpolation are smooth pairwise (true for a source without smooth()).
+template <class S>
+[[nodiscard]] inline bool sources_smooth(const S& s, const sample_of<S>& a, const sample_of<S>& b) {
+  if constexpr (member_smooth<S>) {
+    return static_cast<bool>(s.smooth(a, b));
+  } else {
+    return true;
+  }
+}
+// Of a cell's corners a, b, c, d (00, 10, 01, 11): its two diagonals, the pairs furthest apart.
+template <class S>
+[[nodiscard]] inline bool sources_smooth(const S& s, const sample_of<S>& a, const sample_of<S>& b, const sample_of<S>& c,
+                                         const sample_of<S>& d) {
+  return sources_smooth(s, a, d) && sources_smooth(s, b, c);
 }
 template <class S>
 [[nodiscard]] inline sample_of<S> source_interpolate(const S& s, const sample_of<S>& a, const sample_of<S>& b) {

@@ -336,22 +336,25 @@ class upsampler {
     for (std::uint32_t i = 0; i < w; ++i) {
       if ((j & 1u) == 0 && (i & 1u) == 0) {
         store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
-      } else if (!interpolate_between(src, d, i, j, r0, r1, out, counts)) {
+      } else if (!interpolate_between<false>(src, d, i, j, r0, r1, out, counts)) {
         store(src, d, i, j, src.evaluate(i << d, j << d), sample_kind::evaluated, out, counts);
       }
     }
   }
 
   // §4's test for the new sample (i, j): when its 2 (edge) or 4 (centre) previous-pass samples
-  // may be interpolated with each other (and agree), stores their interpolation and returns true.
-  template <class S, class Pixel>
+  // may be interpolated with each other (and agree, and with Unprobed are smooth), stores their
+  // interpolation and returns true.
+  template <bool Unprobed, class S, class Pixel>
   bool interpolate_between(const S& src, std::uint32_t d, std::uint32_t i, std::uint32_t j, const Sample* r0,
                            const Sample* r1, std::span<Pixel> out, std::array<std::size_t, 3>& counts) {
     const std::uint32_t a = i / 2;
     if ((j & 1u) == 0 || (i & 1u) == 0) {  // edge: horizontal on even rows, vertical on odd ones
       const Sample& s0 = r0[a];
       const Sample& s1 = (j & 1u) ? r1[a] : r0[a + 1];
-      if (!detail::may_interpolate(src, s0, s1) || !detail::sources_agree(src, s0, s1)) return false;
+      if (!detail::may_interpolate(src, s0, s1) || !detail::sources_agree(src, s0, s1) ||
+          (Unprobed && !detail::sources_smooth(src, s0, s1)))
+        return false;
       store(src, d, i, j, detail::source_interpolate(src, s0, s1), sample_kind::interpolated, out, counts);
       return true;
     }
@@ -360,7 +363,8 @@ class upsampler {
     const Sample& s01 = r1[a];
     const Sample& s11 = r1[a + 1];
     if (!detail::may_interpolate(src, s00, s10) || !detail::may_interpolate(src, s00, s01) ||
-        !detail::may_interpolate(src, s00, s11) || !detail::sources_agree(src, s00, s10, s01, s11))
+        !detail::may_interpolate(src, s00, s11) || !detail::sources_agree(src, s00, s10, s01, s11) ||
+        (Unprobed && !detail::sources_smooth(src, s00, s10, s01, s11)))
       return false;
     store(src, d, i, j, detail::source_interpolate(src, s00, s10, s01, s11), sample_kind::interpolated, out, counts);
     return true;
@@ -403,7 +407,7 @@ class upsampler {
         store(src, d, i, j, Sample(r0[i / 2]), sample_kind::reused, out, counts);
         continue;
       }
-      if (!options_.probe_every_sample && interpolate_between(src, d, i, j, r0, r1, out, counts)) continue;
+      if (!options_.probe_every_sample && interpolate_between<true>(src, d, i, j, r0, r1, out, counts)) continue;
       xs[n++] = i << d;
       if (n == block) flush();
     }
