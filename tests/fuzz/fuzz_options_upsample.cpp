@@ -85,6 +85,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   ro.view_origin = {r.real_f(), r.real_f(), r.real_f()};
   ro.view_forward = {r.real_f(), r.real_f(), r.real_f()};
   ro.tolerance = r.real_f();
+  ro.smooth_angle = r.real_f();
   const fixed_tracer wild{{0, r.u8() % 4u, {r.real_f(), r.real_f()}, r.real_f()}};
   infolerp::indexed_mesh m = fuzz::read_mesh(r, 12, 16);
   if (flags & 32) {

@@ -274,16 +274,20 @@ struct plain_material {
   }
 };
 
-template <class M>
+// Probes = refine renders with probes only where sources differ (smooth() asked).
+template <probe_mode Probes = probe_mode::none, class M>
 outcome run_ray_cast(const M& m, const ray_cast_options& o) {
   const support::brute_force_tracer tracer{&m};
   const std::vector<std::uint32_t> ids(m.triangles.size(), 0);
   auto geometry = [&m](std::uint32_t) -> const M& { return m; };
-  auto src = ray_cast_source<support::brute_force_tracer, sphere_camera, decltype(geometry), plain_material>::create(
+  auto src = ray_cast_source<support::brute_force_tracer, sphere_camera, decltype(geometry), plain_material, Probes>::create(
       tracer, sphere_camera{}, geometry, plain_material{}, {std::span<const std::uint32_t>(ids)}, o);
   if (!src) return {src.error()};
   std::vector<glm::vec3> out(16 * 16, glm::vec3(-7.0f));
-  if (status st = upsample(*src, 16, 16, std::span<glm::vec3>(out), {.passes = 2}); !st) return {st};
+  const upsampler_options uo{.passes = 3, .max_passes = 3, .min_sources = 1, .probe_every_sample = Probes == probe_mode::none};
+  if (status st = upsample(*src, 16, 16, std::span<glm::vec3>(out), Probes == probe_mode::none ? upsampler_options{.passes = 2} : uo);
+      !st)
+    return {st};
   bool ok = true;
   for (const auto& p : out) ok = ok && finite(p);
   return {{}, ok};
@@ -551,6 +555,8 @@ std::vector<option_row> upsample_rows() {
       {"ray_cast_source::create", "view_forward", true, 0, {},
        rc([](ray_cast_options& o, double x) { o.view_forward = {0.0f, as_float(x), -1.0f}; })},
       {"ray_cast_source::create", "tolerance", true, 0, {}, rc([](ray_cast_options& o, double x) { o.tolerance = as_float(x); })},
+      {"ray_cast_source::create", "smooth_angle", true, 0, {},
+       [](double x) { return run_ray_cast<probe_mode::refine>(sphere(), {.ao_rays = 4, .smooth_angle = as_float(x)}); }},
   };
 }
 
