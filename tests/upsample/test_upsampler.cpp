@@ -515,39 +515,46 @@ TEST_CASE("with probes, each new sample is tested with its own cluster id", "[up
   }
 }
 
+// Calls check(edges, min_sources, passes) for the region scene without and with its boundaries,
+// min_sources 1 and 2, and 2 to 5 passes.
+template <class F>
+void for_region_settings(F&& check) {
+  for (bool edges : {false, true})
+    for (std::uint32_t min_sources : {1u, 2u})
+      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
+        INFO("cluster and shadow edges " << edges << ", passes " << passes << ", min_sources " << min_sources);
+        check(edges, min_sources, passes);
+      }
+}
+
 TEST_CASE("with probes: the cheap part is exact everywhere, the expensive part exact on one cluster", "[upsample]") {
-  for (bool edges : {false, true}) {
-    INFO("cluster and shadow edges " << edges);
+  for_region_settings([](bool edges, std::uint32_t min_sources, std::uint32_t passes) {
     probing<region_source> src;
     set_edges(src.inner, edges);
     const std::uint32_t w = 150, h = 333;
-    for (std::uint32_t min_sources : {1u, 2u})
-      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
-        INFO("passes " << passes << " min_sources " << min_sources);
-        auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
-                                                            .min_sources = min_sources});
-        REQUIRE(u.ok());
-        auto out = poisoned<region_source>(w, h);
-        REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
-        const auto ib = u->ibuffer();
-        const primary_errors e = check_primary(ib, src.inner, w, h);
-        CHECK(e.wrong == 0);
-        CHECK(e.unset == 0);
-        std::size_t wrong = 0;
-        for (std::uint32_t y = 0; y < h; ++y)
-          for (std::uint32_t x = 0; x < w; ++x) wrong += same_bits(ib[y * w + x], src.inner.evaluate(x, y)) ? 0 : 1;
-        if (!edges) {
-          CHECK(wrong == 0);
-          CHECK(u->stats().evaluated() == u->stats().pass[0].evaluated);
-        }
-        // Fewer evaluations than the plain I-Buffer: a boundary sample is completed from the
-        // sources on its own side instead of being evaluated.
-        auto plain = make(w, h, passes);
-        REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out)).ok());
-        if (edges) CHECK(u->stats().evaluated() < plain.stats().evaluated());
-        if (!edges) CHECK(u->stats().evaluated() == plain.stats().evaluated());
-      }
-  }
+    auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
+                                                        .min_sources = min_sources});
+    REQUIRE(u.ok());
+    auto out = poisoned<region_source>(w, h);
+    REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+    const auto ib = u->ibuffer();
+    const primary_errors e = check_primary(ib, src.inner, w, h);
+    CHECK(e.wrong == 0);
+    CHECK(e.unset == 0);
+    std::size_t wrong = 0;
+    for (std::uint32_t y = 0; y < h; ++y)
+      for (std::uint32_t x = 0; x < w; ++x) wrong += same_bits(ib[y * w + x], src.inner.evaluate(x, y)) ? 0 : 1;
+    if (!edges) {
+      CHECK(wrong == 0);
+      CHECK(u->stats().evaluated() == u->stats().pass[0].evaluated);
+    }
+    // Fewer evaluations than the plain I-Buffer: a boundary sample is completed from the
+    // sources on its own side instead of being evaluated.
+    auto plain = make(w, h, passes);
+    REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out)).ok());
+    if (edges) CHECK(u->stats().evaluated() < plain.stats().evaluated());
+    if (!edges) CHECK(u->stats().evaluated() == plain.stats().evaluated());
+  });
 }
 
 // With probes, for min_sources 1 and 2: serial and 2/8-worker outputs and kinds are
@@ -594,48 +601,43 @@ TEST_CASE("with probes, serial and parallel outputs are bit-identical", "[upsamp
 TEST_CASE("refined probes: refined only where two agreeing sources do not suffice, same result as full probes", "[upsample]") {
   static_assert(infolerp::refining_sample_source<refining<region_source>>);
   static_assert(!infolerp::refining_sample_source<probing<region_source>>);
-  for (bool edges : {false, true}) {
-    INFO("cluster and shadow edges " << edges);
+  for_region_settings([](bool edges, std::uint32_t min_sources, std::uint32_t passes) {
     refining<region_source> src;
     probing<region_source> full;
     for (auto* inner : {&src.inner, &full.inner}) set_edges(*inner, edges);
     const std::uint32_t w = 150, h = 333;
-    for (std::uint32_t min_sources : {1u, 2u})
-      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
-        INFO("passes " << passes << " min_sources " << min_sources);
-        auto create = [&] {
-          auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
-                                                              .min_sources = min_sources});
-          REQUIRE(u.ok());
-          return std::move(*u);
-        };
-        auto u = create();
-        src.probes = 0;
-        src.refinements = 0;
-        auto out = poisoned<region_source>(w, h);
-        REQUIRE(u.render(src, std::span<glm::vec4>(out)).ok());
-        const auto ib = u.ibuffer();
-        const primary_errors e = check_primary(ib, src.inner, w, h);
-        CHECK(e.wrong == 0);
-        CHECK(e.unset == 0);
-        CHECK(src.probes.load() > 0);
-        if (!edges) CHECK(src.refinements.load() == 0);
-        if (edges) {
-          CHECK(src.refinements.load() > 0);
-          CHECK(src.refinements.load() * 10 < src.probes.load());
-        }
-        // The regions are convex, so two sources that agree on the light bits have the new
-        // sample's: the cheap probes give exactly what full probes give.
-        auto f = create();
-        auto out_full = poisoned<region_source>(w, h);
-        REQUIRE(f.render(full, std::span<glm::vec4>(out_full)).ok());
-        std::size_t differ = 0;
-        for (std::size_t i = 0; i < ib.size(); ++i) differ += same_bits(ib[i], f.ibuffer()[i]) ? 0 : 1;
-        CHECK(differ == 0);
-        CHECK(u.stats().evaluated() == f.stats().evaluated());
-        CHECK(std::memcmp(out.data(), out_full.data(), out.size() * sizeof(glm::vec4)) == 0);
-      }
-  }
+    auto create = [&] {
+      auto u = infolerp::upsampler<sample>::create(w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true,
+                                                          .min_sources = min_sources});
+      REQUIRE(u.ok());
+      return std::move(*u);
+    };
+    auto u = create();
+    src.probes = 0;
+    src.refinements = 0;
+    auto out = poisoned<region_source>(w, h);
+    REQUIRE(u.render(src, std::span<glm::vec4>(out)).ok());
+    const auto ib = u.ibuffer();
+    const primary_errors e = check_primary(ib, src.inner, w, h);
+    CHECK(e.wrong == 0);
+    CHECK(e.unset == 0);
+    CHECK(src.probes.load() > 0);
+    if (!edges) CHECK(src.refinements.load() == 0);
+    if (edges) {
+      CHECK(src.refinements.load() > 0);
+      CHECK(src.refinements.load() * 10 < src.probes.load());
+    }
+    // The regions are convex, so two sources that agree on the light bits have the new
+    // sample's: the cheap probes give exactly what full probes give.
+    auto f = create();
+    auto out_full = poisoned<region_source>(w, h);
+    REQUIRE(f.render(full, std::span<glm::vec4>(out_full)).ok());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < ib.size(); ++i) differ += same_bits(ib[i], f.ibuffer()[i]) ? 0 : 1;
+    CHECK(differ == 0);
+    CHECK(u.stats().evaluated() == f.stats().evaluated());
+    CHECK(std::memcmp(out.data(), out_full.data(), out.size() * sizeof(glm::vec4)) == 0);
+  });
 }
 
 TEST_CASE("refined probes: a shadow between two agreeing sources is interpolated over, one source refines", "[upsample]") {
@@ -664,48 +666,43 @@ TEST_CASE("refined probes: serial and parallel outputs are bit-identical", "[ups
 }
 
 TEST_CASE("probes only where sources differ: none on one cluster, exact primary parts, fewer probes and evaluations", "[upsample]") {
-  for (bool edges : {false, true}) {
-    INFO("cluster and shadow edges " << edges);
+  for_region_settings([](bool edges, std::uint32_t min_sources, std::uint32_t passes) {
     refining<region_source> src;
     set_edges(src.inner, edges);
     const std::uint32_t w = 150, h = 333;
-    for (std::uint32_t min_sources : {1u, 2u})
-      for (std::uint32_t passes = 2; passes <= 5; ++passes) {
-        INFO("passes " << passes << " min_sources " << min_sources);
-        auto render = [&](bool every, std::vector<glm::vec4>& out) {
-          auto u = infolerp::upsampler<sample>::create(
-              w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true, .min_sources = min_sources,
-                     .probe_every_sample = every});
-          REQUIRE(u.ok());
-          src.probes = 0;
-          out = poisoned<region_source>(w, h);
-          REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
-          return std::move(*u);
-        };
-        std::vector<glm::vec4> out, out_every;
-        const auto every = render(true, out_every);
-        const std::uint32_t probes_every = src.probes.load();
-        const auto u = render(false, out);
-        const std::uint32_t probes = src.probes.load();
-        // Attributes linear in each convex region: interpolating within one is exact, so every
-        // primary part (light bits included) is exact whether it came from a probe or not.
-        const primary_errors e = check_primary(u.ibuffer(), src.inner, w, h);
-        CHECK(e.wrong == 0);
-        CHECK(e.unset == 0);
-        auto plain = make(w, h, passes);
-        REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out_every)).ok());
-        if (!edges) {  // one cluster: the plain frame, no probe at all
-          CHECK(probes == 0);
-          CHECK(std::memcmp(out.data(), out_every.data(), out.size() * sizeof(glm::vec4)) == 0);
-        } else {  // a probe per boundary sample, not per pixel; fewer evaluations than without probes
-          CHECK(probes > 0);
-          CHECK(probes * 10 < probes_every);
-          CHECK(u.stats().evaluated() < plain.stats().evaluated());
-        }
-        CHECK(u.stats().evaluated() <= plain.stats().evaluated());
-        CHECK(u.stats().interpolated() >= every.stats().interpolated());
-      }
-  }
+    auto render = [&](bool every, std::vector<glm::vec4>& out) {
+      auto u = infolerp::upsampler<sample>::create(
+          w, h, {.passes = passes, .max_passes = 5, .keep_ibuffer = true, .min_sources = min_sources,
+                 .probe_every_sample = every});
+      REQUIRE(u.ok());
+      src.probes = 0;
+      out = poisoned<region_source>(w, h);
+      REQUIRE(u->render(src, std::span<glm::vec4>(out)).ok());
+      return std::move(*u);
+    };
+    std::vector<glm::vec4> out, out_every;
+    const auto every = render(true, out_every);
+    const std::uint32_t probes_every = src.probes.load();
+    const auto u = render(false, out);
+    const std::uint32_t probes = src.probes.load();
+    // Attributes linear in each convex region: interpolating within one is exact, so every
+    // primary part (light bits included) is exact whether it came from a probe or not.
+    const primary_errors e = check_primary(u.ibuffer(), src.inner, w, h);
+    CHECK(e.wrong == 0);
+    CHECK(e.unset == 0);
+    auto plain = make(w, h, passes);
+    REQUIRE(plain.render(src.inner, std::span<glm::vec4>(out_every)).ok());
+    if (!edges) {  // one cluster: the plain frame, no probe at all
+      CHECK(probes == 0);
+      CHECK(std::memcmp(out.data(), out_every.data(), out.size() * sizeof(glm::vec4)) == 0);
+    } else {  // a probe per boundary sample, not per pixel; fewer evaluations than without probes
+      CHECK(probes > 0);
+      CHECK(probes * 10 < probes_every);
+      CHECK(u.stats().evaluated() < plain.stats().evaluated());
+    }
+    CHECK(u.stats().evaluated() <= plain.stats().evaluated());
+    CHECK(u.stats().interpolated() >= every.stats().interpolated());
+  });
 }
 
 TEST_CASE("probes only where sources differ: a feature between agreeing sources is missed, as without probes", "[upsample]") {

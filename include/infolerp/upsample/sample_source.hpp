@@ -22,31 +22,23 @@
 // across thread counts. Pixels may lie up to 2^(passes-1) - 1 beyond the right and bottom edge
 // (the cropped border of §4); a pinhole camera extrapolates naturally.
 //
-// Optionally, a probe (the CPU counterpart of a rasteriser's cluster-ID buffer): the cheap, sharp
-// part of a sample at every pixel, the expensive, smooth part interpolated:
-//   sample_type probe(uint32_t x, uint32_t y) const      primary hit: cluster id, position,
+// Optional members (found by concepts below; member or ADL where noted):
+//   sample_type probe(uint32_t x, uint32_t y) const      the cheap, sharp part of a sample (the
+//        CPU counterpart of a rasteriser's cluster-ID buffer): primary hit, cluster id, position,
 //        normal, texcoords, hard-shadow bits; occlusion left unset
-//   sample_type interpolate(const sample_type& probe, a, b)  /  (probe, a, b, c, d)
-//        the probe completed with the expensive terms of its sources (member or ADL)
-//   bool probe_compatible(const sample_type& probe, const sample_type& s)   optional (default
-//        compatible): for probes that leave out part of what compatible() compares
-//   sample_type refine_probe(const sample_type& probe, uint32_t x, uint32_t y) const   optional:
-//        adds what the probe left out so that compatible() holds as for a full evaluation; called
-//        only where the agreeing, bracketing sources do not suffice (upsampler.hpp)
+//   sample_type interpolate(probe, a, b) / (probe, a, b, c, d)   with probes: the probe completed
+//        with the expensive, smooth terms of its sources (member or ADL)
+//   bool probe_compatible(probe, s)      default compatible(): for probes that leave out part of it
+//   sample_type refine_probe(probe, x, y) const   adds what the probe left out; called only where
+//        the agreeing, bracketing sources do not suffice (upsampler.hpp)
 //   void probe(uint32_t y, std::span<const uint32_t> xs, std::span<sample_type> out) const
-//        optional: out[k] = probe(xs[k], y) for every k (xs ascending, out.size() == xs.size()),
-//        e.g. the primary rays of a row traced as packets; the upsampler then probes in batches
-//
-// Optionally, for probes only where sources differ (upsampler_options::probe_every_sample off):
-// bool smooth(const sample_type& a, const sample_type& b) const, whether a sample between a and
-// b may take its geometry (position, normal, texcoords) from them without a probe, e.g. normals
-// within an angle (normals_within below); where not, it is probed. Symmetric, thread-safe and
-// deterministic like compatible().
-// Optionally, beyond the paper: bool agree(const sample_type& a, const sample_type& b) const
-// (member: a tolerance is the source's state), e.g. expensive terms within a tolerance
-// (occlusion_within below); a new sample is evaluated unless every pair of its sources agrees.
-// Symmetric, thread-safe and deterministic like compatible(), need not be transitive. A source
-// that always agrees gives exactly the frame of one without agree().
+//        out[k] = probe(xs[k], y), xs ascending: e.g. a row's primary rays as packets
+//   bool smooth(a, b) const   with probes only where sources differ: may a sample between a and b
+//        take its geometry from them unprobed (e.g. normals_within below)
+//   bool agree(a, b) const    beyond the paper: a new sample is evaluated unless every pair of its
+//        sources agrees (e.g. occlusion_within below); need not be transitive, and a source that
+//        always agrees gives exactly the frame of one without it
+// smooth() and agree() are symmetric, thread-safe and deterministic like compatible().
 #include <array>
 #include <cmath>
 #include <concepts>
@@ -105,8 +97,7 @@ template <std::size_t K, bool L>
 // reciprocal of the sum), and the new inv_depth is the plain mean. With inv_depth = 1 everywhere the weights are exactly 1/2 (1/4):
 // screen-linear interpolation, exact for attributes linear in screen space.
 // Each interpolation builds its result member by member: copying a whole record and then
-// overwriting most of it cost 5-7 ns per interpolated pixel (BM_UpsampleInterpolatedPixel, one
-// core: 13.9 -> 8.5 ns plain, 21.5 -> 14.1 ns with probes, 18.3 -> 10.9 ns with refined probes).
+// overwriting most of it was measurably slower (benchmarks/NOTES.md, BM_UpsampleInterpolatedPixel).
 
 // Midpoint of an edge: continuous attributes weighted by inv_depth, cluster and light bits
 // taken from a (equal to b's whenever compatible(a, b)). O(1), no allocation.
