@@ -526,8 +526,8 @@ struct prepared_visibility_channel {
 
 struct visibility_channel {
   double threshold = 0.48;             // JS threshold Th in [0,1]
-  std::uint32_t viewpoints = 64;       // N viewpoints on the bounding sphere (>= 1; T·N <= 2^28: the
-                                       // T·N bytes of counts stay under 256 MiB)
+  std::uint32_t viewpoints = 64;       // N viewpoints on the bounding sphere (1..2^20, 24 bytes of
+                                       // points each; T·N <= 2^28: the counts stay under 256 MiB)
   std::uint32_t samples_per_side = 2;  // n: n² stratified samples per triangle (1..15)
   double radius_scale = 1.0;           // sphere radius in half bounding-box diagonals (>= 1)
   bool denoise = true;                 // §3.2.1 row denoising
@@ -585,8 +585,9 @@ struct visibility_channel {
   }
 
   static constexpr std::size_t max_visibility_entries = std::size_t{1} << 28;  // T·N bound (bytes of counts)
+  static constexpr std::uint32_t max_viewpoints = std::uint32_t{1} << 20;       // N bound (points, per-viewpoint sums)
 
-  // Traces the occlusion rays. Errors: viewpoints == 0 or T·N above 2^28, samples_per_side outside 1..15,
+  // Traces the occlusion rays. Errors: viewpoints outside 1..2^20 or T·N above 2^28, samples_per_side outside 1..15,
   // radius_scale < 1 or NaN, and the image options (see images). Complexity O(T·N·n²) rays
   // (images: N·R² primary rays + n² per fallback triangle and viewpoint), allocation T·N bytes +
   // one ray buffer per task (+ T·N verdict bytes with adaptive_neighbours; + V points and
@@ -598,6 +599,8 @@ struct visibility_channel {
     static_assert(check_tracer<T>());
     static_assert(check_executor<std::remove_cvref_t<E>>());
     if (viewpoints == 0) return make_error(errc::bad_parameter, no_element, "visibility channel: zero viewpoints");
+    if (viewpoints > max_viewpoints)
+      return make_error(errc::bad_parameter, no_element, "visibility channel: ", viewpoints, " viewpoints above 2^20");
     if (std::size_t{viewpoints} * mesh_triangle_count(m) > max_visibility_entries)
       return make_error(errc::bad_parameter, no_element, "visibility channel: ", viewpoints, " viewpoints x ",
                         mesh_triangle_count(m), " triangles exceed the 2^28 visibility counts");
