@@ -26,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   vis.images = (flags & 32) != 0;
   vis.image_resolution = r.count<std::uint32_t>();
   vis.image_min_pixels = r.real();
-  if (vis.viewpoints > 12 && vis.viewpoints <= (1u << 20)) vis.viewpoints %= 12;  // valid and costly: fold
+  if (vis.viewpoints > 12 && vis.viewpoints <= vis.max_viewpoints) vis.viewpoints %= 12;  // valid and costly: fold
   if (vis.image_resolution > 32 && vis.image_resolution <= 16384) vis.image_resolution %= 32;
   const infolerp::orientation_channel ori{.threshold = r.real(), .bins = r.count<std::uint32_t>(),
                                           .exact_rows = (r.u8() & 1) != 0};

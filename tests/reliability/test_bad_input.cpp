@@ -499,9 +499,10 @@ TEST_CASE("bad-input matrix: clustering options and channels", "[reliability][ba
   const infolerp::serial_executor serial;
   auto vis = [&](infolerp::visibility_channel c) { return status_of(infolerp::cluster_mesh(m, tracer, serial, c)); };
   auto ori = [&](infolerp::orientation_channel c) { return status_of(infolerp::cluster_mesh(m, tracer, serial, c)); };
-  check_cell("zero viewpoints", "cluster_mesh(visibility)", vis({.viewpoints = 0}), {errc::bad_parameter, "zero viewpoints"});
+  check_cell("zero viewpoints", "cluster_mesh(visibility)", vis({.viewpoints = 0}),
+             {errc::bad_parameter, "viewpoints 0 outside 1..2^20"});
   check_cell("count above size", "cluster_mesh(visibility)", vis({.viewpoints = (1u << 20) + 1}),
-             {errc::bad_parameter, "1048577 viewpoints above 2^20"});
+             {errc::bad_parameter, "viewpoints 1048577 outside 1..2^20"});
   check_cell("zero count", "cluster_mesh(visibility)", vis({.viewpoints = 4, .samples_per_side = 0}),
              {errc::bad_parameter, "samples_per_side 0"});
   check_cell("count above size", "cluster_mesh(visibility)", vis({.viewpoints = 4, .samples_per_side = 16}),

@@ -598,9 +598,8 @@ struct visibility_channel {
     static_assert(check_mesh<M>());
     static_assert(check_tracer<T>());
     static_assert(check_executor<std::remove_cvref_t<E>>());
-    if (viewpoints == 0) return make_error(errc::bad_parameter, no_element, "visibility channel: zero viewpoints");
-    if (viewpoints > max_viewpoints)
-      return make_error(errc::bad_parameter, no_element, "visibility channel: ", viewpoints, " viewpoints above 2^20");
+    if (viewpoints == 0 || viewpoints > max_viewpoints)
+      return make_error(errc::bad_parameter, no_element, "visibility channel: viewpoints ", viewpoints, " outside 1..2^20");
     if (std::size_t{viewpoints} * mesh_triangle_count(m) > max_visibility_entries)
       return make_error(errc::bad_parameter, no_element, "visibility channel: ", viewpoints, " viewpoints x ",
                         mesh_triangle_count(m), " triangles exceed the 2^28 visibility counts");
