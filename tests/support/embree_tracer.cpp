@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <utility>
 #if defined(__SSE__) || defined(_M_X64)
 #include <pmmintrin.h>
@@ -68,7 +69,20 @@ void set_valid(int (&valid)[packet], std::size_t n) {
 
 // ---- device ---------------------------------------------------------------------------------
 
-embree_device::embree_device(const char* config) : device_(rtcNewDevice(config)) {
+namespace {
+// The caller's configuration followed by INFOLERP_EMBREE_CONFIG's (Embree reads the last value of
+// a key), so that a whole test run can be moved to other kernels, e.g. "max_isa=sse4.2".
+std::string device_config(const char* config) {
+  std::string s = config ? config : "";
+  if (const char* env = std::getenv("INFOLERP_EMBREE_CONFIG"); env && *env) {
+    if (!s.empty()) s.push_back(',');
+    s.append(env);
+  }
+  return s;
+}
+}  // namespace
+
+embree_device::embree_device(const char* config) : device_(rtcNewDevice(device_config(config).c_str())) {
   if (device_ == nullptr) {
     std::fprintf(stderr, "infolerp: cannot create an Embree device (error %d)\n",
                  static_cast<int>(rtcGetDeviceError(nullptr)));

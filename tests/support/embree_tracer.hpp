@@ -32,7 +32,8 @@ void enable_flush_to_zero();
 // a scene built from it) goes away.
 class embree_device {
  public:
-  // `config` is Embree's device configuration string ("" = defaults, e.g. "threads=1").
+  // `config` is Embree's device configuration string ("" = defaults, e.g. "threads=1"); the
+  // environment variable INFOLERP_EMBREE_CONFIG is appended to it (CI moves runs to other ISAs).
   // Device creation failure (e.g. an unsupported CPU) is fatal: it prints Embree's error and aborts.
   explicit embree_device(const char* config = "");
   embree_device(embree_device&& other) noexcept;
