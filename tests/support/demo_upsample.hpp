@@ -113,19 +113,15 @@ struct demo_ibuffer_source {
   }
   // shade() reads the view direction only for the sky and the sun's highlight, so the primary
   // ray is rebuilt only for those pixels (the same bits as always rebuilding it). The normal is
-  // renormalised (interpolated normals are not unit) unless unit_normals says it is unit.
-  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y, bool unit_normals = false) const {
+  // renormalised: interpolated normals are not unit.
+  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
     shading_inputs in;
     if (s.background() || (s.lights & sun_light_bit) != 0)
       in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
     if (s.background()) return in;
     in.position = s.position;
-    if (unit_normals) {
-      in.normal = s.normal;
-    } else {
-      const float len = glm::length(s.normal);
-      in.normal = len > 0.0f ? s.normal / len : s.normal;
-    }
+    const float len = glm::length(s.normal);
+    in.normal = len > 0.0f ? s.normal / len : s.normal;
     in.uv = s.texcoord;
     in.geometry = clusters->geometry_of[s.cluster];
     in.light_bits = s.lights;
@@ -142,16 +138,11 @@ struct demo_ibuffer_source {
 // (shader_options{.ao_rays = 0, .soft_shadow_rays = 0, .hard_shadow = probe_lights}). AO and
 // soft shadow (80 of a full evaluation's 82 rays), and without probe_lights the sun bit too, are
 // interpolated; then the sources must agree on the sun bit, as in the plain I-Buffer.
-// Every sample's normal is then an evaluated, unit one (a probe's or a full evaluation's: the
-// probe interpolation takes the probe's), so shade() uses it as it is.
+// With a probe at every sample the normals are evaluated, unit ones; with probes only where sources
+// differ, whole interpolations are not, so shade() renormalises as without probes.
 struct demo_probe_source : demo_ibuffer_source {
   const reference_shader* primary = nullptr;
   bool probe_lights = true;
-
-  shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
-    return demo_ibuffer_source::to_inputs(s, x, y, true);
-  }
-  glm::vec3 shade(const demo_sample& s, std::uint32_t x, std::uint32_t y) const { return shader->shade(to_inputs(s, x, y)); }
 
   demo_sample probe(std::uint32_t x, std::uint32_t y) const {
     std::uint64_t rays = 0;

@@ -198,3 +198,44 @@ TEST_CASE("ray cast source: bad options are named", "[upsample][ray_cast_source]
   b.normal = {std::sin(0.09f), 0.0f, std::cos(0.09f)};  // 5.2 degrees
   CHECK(!five->smooth(a, b));
 }
+
+namespace {
+// Renders a sphere with vertex normals (one cluster, so whole interpolations cross curved cells)
+// through an upsampler and returns the largest | |n| - 1 | among the records the material saw.
+template <probe_mode Probes>
+float worst_material_normal(bool probe_every_sample) {
+  infolerp::indexed_mesh m = support::make_icosphere(2);
+  m.normals = m.positions;  // unit: the icosphere's vertices lie on the unit sphere
+  const support::brute_force_tracer tracer{&m};
+  const auto camera = [](float x, float y) {  // 48×48 pinhole at z = 3 looking down -z
+    return infolerp::ray{{0.0f, 0.0f, 3.0f}, 0.0f, glm::normalize(glm::vec3((x - 24.0f) / 56.0f, (y - 24.0f) / 56.0f, -1.0f))};
+  };
+  const auto geometry = [&](std::uint32_t) -> const infolerp::indexed_mesh& { return m; };
+  float worst = 0.0f;
+  std::size_t seen = 0;
+  const auto material = [&worst, &seen](const infolerp::surface_sample<2>& s, const auto&) {
+    if (!s.background()) worst = std::max(worst, std::abs(glm::length(s.normal) - 1.0f)), ++seen;
+    return s.normal;
+  };
+  const std::vector<std::uint32_t> ids(m.triangle_count(), 0);
+  auto src = infolerp::ray_cast_source<support::brute_force_tracer, decltype(camera), decltype(geometry), decltype(material),
+                                       Probes>::create(tracer, camera, geometry, material, {std::span<const std::uint32_t>(ids)},
+                                                       {.ao_rays = 0});
+  REQUIRE(src);
+  auto up = infolerp::upsampler<infolerp::surface_sample<2>>::create(
+      48, 48, {.passes = 4, .max_passes = 4, .min_sources = 2, .probe_every_sample = probe_every_sample});
+  REQUIRE(up);
+  std::vector<glm::vec3> out(48 * 48);
+  REQUIRE(up->render(*src, std::span<glm::vec3>(out)));
+  CHECK(seen > 48 * 48 / 4);  // the sphere covers a good part of the frame
+  return worst;
+}
+}  // namespace
+
+TEST_CASE("ray cast source: the material sees unit normals in every probe mode", "[upsample][ray_cast_source]") {
+  CHECK(worst_material_normal<probe_mode::none>(true) <= 1e-6f);
+  CHECK(worst_material_normal<probe_mode::primary>(true) <= 1e-6f);
+  CHECK(worst_material_normal<probe_mode::primary>(false) <= 1e-6f);
+  CHECK(worst_material_normal<probe_mode::refine>(true) <= 1e-6f);
+  CHECK(worst_material_normal<probe_mode::refine>(false) <= 1e-6f);
+}

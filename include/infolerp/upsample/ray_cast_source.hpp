@@ -156,11 +156,12 @@ class ray_cast_source {
   // §4: full evaluation of pixel (x, y).
   sample_type evaluate(std::uint32_t x, std::uint32_t y) const { return trace(x, y, true, true); }
 
-  // The record's colour: the material callback with a unit normal (interpolated normals are
-  // renormalised; probes' normals are evaluated ones and used as they are).
+  // The record's colour: the material callback with a unit normal. Interpolated normals are
+  // renormalised in every probe mode: with probes only where sources differ, whole
+  // interpolations reach the material too.
   auto shade(const sample_type& s, std::uint32_t x, std::uint32_t y) const {
     const auto view = [&] { return glm::normalize(camera_(pixel(x), pixel(y)).direction); };
-    if (s.background() || Probes != probe_mode::none) return material_(s, view);
+    if (s.background()) return material_(s, view);
     sample_type unit = s;
     const float len = glm::length(s.normal);
     if (len > 0.0f) unit.normal = s.normal / len;
