@@ -1,6 +1,6 @@
 // saliency/salient_clustering.hpp: partition invariants, determinism (per seed, per executor),
-// distinct seeds and no empty cluster, the flat tie-break (a plane, fandisk), the seed
-// tolerance, unreached components, the PRNG's reference sequence, and eq. (4) by hand.
+// distinct seeds and no empty cluster, the flat tie-break (a plane, fandisk), unreached
+// components, the PRNG's reference sequence, and eq. (4) by hand.
 #include <catch2/catch.hpp>
 
 #include <algorithm>

@@ -1,7 +1,11 @@
 #pragma once
 // Status and result types: how every infolerp entry point reports bad input.
 // The library throws nothing and builds with -fno-exceptions -fno-rtti; a failing entry point
-// returns a status whose message names the offending element (triangle 17, bin 3, ...).
+// returns a status whose message names the offending element (triangle 17, bin 3, ...). The one
+// exception it does not catch is the standard library's: built with exceptions, an allocation
+// that fails (a status's message, a result's vectors) throws std::bad_alloc as any std::vector
+// would; without them it terminates. Sizes that inputs or options control are bounded and refused
+// with a status before allocating.
 #include <cassert>
 #include <charconv>
 #include <cmath>
