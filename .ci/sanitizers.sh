@@ -8,7 +8,8 @@
 #     of -O1, more than the tests lose by running slower; the fuzz targets keep -O1 for their rate.
 #     The saliency kernels are capped at AVX2 here (INFOLERP_NO_AVX512), so that the AVX2 kernel
 #     also meets the brute-force references on an AVX-512 machine; the g++ stage tests the widest
-#     the machine has and the TSan run below the portable kernels.
+#     the machine has and the TSan run below the portable kernels. Embree runs its SSE4.2
+#     kernels here (INFOLERP_EMBREE_CONFIG), a third set of the tracer's rounding.
 #  2. ThreadSanitizer ("tsan" preset): infolerp_tests_threads, the [threads] tests
 #     (tests/reliability/test_determinism.cpp), which drive every parallel component through
 #     support::thread_pool_executor with 1, 2 and 8 workers. Tests using openmp_executor are
@@ -28,6 +29,7 @@ echo "sanitizers: clang ASan+UBSan build of every target took $((SECONDS - start
 t=$SECONDS
 ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1} \
 UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1} \
+INFOLERP_EMBREE_CONFIG=max_isa=sse4.2 \
   ctest --test-dir build-asan -j"$jobs" --output-on-failure
 echo "sanitizers: clang ASan+UBSan tests took $((SECONDS - t)) s"
 
