@@ -1,7 +1,8 @@
 // Clustering on CGAL's refined_elephant (~89k triangles) and procedural meshes.
 //   BM_Clustering_RefinedElephant   Algorithm 1: visibility → orientation → stretch, one core,
 //                                   visibility rays precomputed outside the timed loop (a regression
-//                                   benchmark: cluster_of_fnv24 must not change).
+//                                   benchmark: cluster_of_fnv24 must equal the exact kernel run's,
+//                                   BM_Clustering_RefinedElephant_Counted/0, in the same run).
 //                                   Counters chN_{prepare,init,growth,smoothing}_ms: channel N's
 //                                   stages in the last iteration (channel_report's stage times).
 //   BM_OrientationChannel/K/rows (CGAL's fandisk), BM_OrientationChannel_Torus/K/rows,
