@@ -15,9 +15,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <span>
 #include <vector>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/lod/screen_error_selection.hpp"
@@ -79,11 +81,30 @@ inline std::vector<std::uint8_t> closed_part_triangles(std::span<const std::uint
   return closed;
 }
 
+// The bounding box of the vertices of one-sided triangles (empty: lo > hi). O(T).
+inline void closed_part_bounds(std::span<const std::uint32_t> indices, std::span<const glm::vec3> positions,
+                               std::span<const std::uint8_t> one_sided, glm::dvec3& lo, glm::dvec3& hi) {
+  lo = glm::dvec3(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t t = 0; t < one_sided.size(); ++t)
+    if (one_sided[t])
+      for (std::size_t j = 0; j < 3; ++j) {
+        const glm::dvec3 p(positions[indices[3 * t + j]]);
+        lo = glm::min(lo, p), hi = glm::max(hi, p);
+      }
+}
+
 // The camera's eye and the inward normals of its frustum's side planes and of the plane through
 // the eye facing forward (no near or far plane).
 struct view_frustum {
   glm::dvec3 eye{0.0};
   glm::dvec3 inward[5]{};
+  glm::vec3 eye_f{0.0f}, inward_f[5]{};  // the same in single precision (hidden_triangle)
+  // A box holding every closed part: an eye outside it is outside them all (no winding pass).
+  glm::dvec3 closed_lo{-std::numeric_limits<double>::infinity()}, closed_hi{std::numeric_limits<double>::infinity()};
+  [[nodiscard]] bool may_be_inside_closed() const {
+    return eye.x >= closed_lo.x && eye.y >= closed_lo.y && eye.z >= closed_lo.z && eye.x <= closed_hi.x &&
+           eye.y <= closed_hi.y && eye.z <= closed_hi.z;
+  }
 };
 
 // Preconditions: check_camera(cam) passed. O(1).
@@ -91,34 +112,40 @@ inline view_frustum make_view_frustum(const lod_camera& cam) {
   const auto [f, right, up] = make_camera_basis(cam);
   const double tv = std::tan(0.5 * cam.vertical_fov);
   const double th = tv * static_cast<double>(cam.width) / static_cast<double>(cam.height);
-  return {cam.position, {f, th * f - right, th * f + right, tv * f - up, tv * f + up}};
+  view_frustum v;
+  v.eye = cam.position, v.eye_f = glm::vec3(cam.position);
+  const glm::dvec3 inward[5] = {f, th * f - right, th * f + right, tv * f - up, tv * f + up};
+  for (int k = 0; k < 5; ++k) v.inward[k] = inward[k], v.inward_f[k] = glm::vec3(inward[k]);
+  return v;
 }
 
 // Whether no pixel of the camera sees triangle (a, b, c): wholly outside one plane of the
 // frustum, or facing away from the eye when `one_sided` (on a closed part). O(1).
 inline bool hidden_triangle(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                             bool one_sided) {
-  const glm::dvec3 pa = glm::dvec3(a) - v.eye, pb = glm::dvec3(b) - v.eye, pc = glm::dvec3(c) - v.eye;
-  for (const glm::dvec3& n : v.inward)
-    if (glm::dot(n, pa) < 0.0 && glm::dot(n, pb) < 0.0 && glm::dot(n, pc) < 0.0) return true;
-  return one_sided && glm::dot(glm::cross(pb - pa, pc - pa), pa) > 0.0;  // normal along eye → a: facing away
+  // Single precision (the positions' own): edges from the corners, not from the eye, so that a
+  // distant eye costs no precision in the normal.
+  const glm::vec3 pa = a - v.eye_f, pb = b - v.eye_f, pc = c - v.eye_f;
+  if (one_sided && glm::dot(glm::cross(b - a, c - a), pa) > 0.0f) return true;  // normal along eye → a: facing away
+  for (const glm::vec3& n : v.inward_f)
+    if (glm::dot(n, pa) < 0.0f && glm::dot(n, pb) < 0.0f && glm::dot(n, pc) < 0.0f) return true;
+  return false;
 }
 
-// The signed crossing of a fixed ray from the eye with triangle (a, b, c): +1 leaving through
-// its front, −1 entering, 0 missing it (or a repeated corner). Summed over a closed part, 0 when
-// the eye is outside it. O(1).
+// The signed crossing of a fixed ray from the eye (a direction of irrational slopes, so that
+// it meets no edge of a mesh built on a grid or a symmetric shape) with triangle (a, b, c): +1
+// leaving through its front (counter-clockwise normal along the ray), −1 entering, 0 missing it.
+// Summed over a closed part, 0 when the eye is outside it. O(1) (Möller–Trumbore).
 inline int eye_ray_crossing(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
-  const glm::dvec3 d(0.5773502691896258, 0.5773502691896257, 0.5773502691896259);  // Möller–Trumbore
-  const glm::dvec3 pa = glm::dvec3(a) - v.eye, e1 = glm::dvec3(b) - glm::dvec3(a), e2 = glm::dvec3(c) - glm::dvec3(a);
-  const glm::dvec3 p = glm::cross(d, e2);
+  const glm::dvec3 d(0.7296190, 0.3022190, 0.5341045);  // ∝ (1, √2 − 1, √3 − 1), rounded
+  const glm::dvec3 pa = glm::dvec3(a) - v.eye, pb = glm::dvec3(b) - v.eye, pc = glm::dvec3(c) - v.eye;
+  if (glm::dot(pa, d) < 0.0 && glm::dot(pb, d) < 0.0 && glm::dot(pc, d) < 0.0) return 0;  // behind the eye
+  const glm::dvec3 e1 = pb - pa, e2 = pc - pa, p = glm::cross(d, e2);
   const double det = glm::dot(e1, p);
   if (det == 0.0) return 0;
-  const glm::dvec3 s = -pa;
-  const double u = glm::dot(s, p) / det;
-  if (!(u >= 0.0 && u <= 1.0)) return 0;
-  const glm::dvec3 q = glm::cross(s, e1);
-  const double w = glm::dot(d, q) / det;
-  if (!(w >= 0.0 && u + w <= 1.0) || !(glm::dot(e2, q) / det > 0.0)) return 0;
+  const glm::dvec3 s = -pa, q = glm::cross(s, e1);
+  const double u = glm::dot(s, p) / det, w = glm::dot(d, q) / det;
+  if (!(u >= 0.0 && w >= 0.0 && u + w <= 1.0) || !(glm::dot(e2, q) / det > 0.0)) return 0;
   return glm::dot(glm::cross(e1, e2), d) > 0.0 ? 1 : -1;
 }
 
@@ -160,6 +187,7 @@ inline visibility_samples make_visibility_samples(const contraction_hierarchy& h
 // Whether the eye is outside every closed part of the coarsest cut (then visible_shares counts
 // back faces hidden). O(coarsest triangles), no allocation.
 inline bool eye_outside_coarsest(const visibility_samples& s, const view_frustum& v) {
+  if (!v.may_be_inside_closed()) return true;
   long winding = 0;
   for (std::size_t i = 0; i < s.coarsest.size(); i += 3) winding += eye_ray_crossing(v, s.coarsest[i], s.coarsest[i + 1], s.coarsest[i + 2]);
   return winding == 0;

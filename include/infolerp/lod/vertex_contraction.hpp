@@ -135,7 +135,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
   const glm::vec3* pos = h.positions.data();
   std::uint32_t* dst = out.data();
   bool back_faces_hidden = view != nullptr;
-  if (view) {  // the eye inside a closed part of the cut sees its back faces: cull none of them
+  if (view && view->may_be_inside_closed()) {  // the eye inside a closed part of the cut sees its back faces: cull none
     exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         std::int32_t n = 0;

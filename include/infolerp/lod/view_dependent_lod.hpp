@@ -128,7 +128,8 @@ class view_dependent_lod {
                         " exceeds the hierarchy's ", capacity(), " contractions");
     lod_frame_stats st;
     st.triangle_budget = kept_[global_contractions];
-    const view_frustum view = make_view_frustum(camera);
+    view_frustum view = make_view_frustum(camera);
+    view.closed_lo = closed_lo_, view.closed_hi = closed_hi_;
     if (opt_.selection == lod_selection::screen_error) {
       if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
       else visible_shares(samples_, view, eye_outside_coarsest(samples_, view), share_);
@@ -166,6 +167,7 @@ class view_dependent_lod {
       for (std::uint32_t g : opt.two_sided)
         std::fill(one_sided_.begin() + h.triangle_offsets[g], one_sided_.begin() + h.triangle_offsets[g + 1], 0);
       samples_ = make_visibility_samples(h, one_sided_);
+      closed_part_bounds(h.indices, h.positions, one_sided_, closed_lo_, closed_hi_);
     }
     opt_.two_sided = {};
   }
@@ -193,6 +195,7 @@ class view_dependent_lod {
   std::vector<std::uint32_t> faces_;                         // cluster_removed_faces
   std::vector<std::uint8_t> one_sided_;                      // per triangle of h.indices: back faces hidden
   visibility_samples samples_;
+  glm::dvec3 closed_lo_{0.0}, closed_hi_{0.0};                // closed_part_bounds
   std::vector<view_patch> patches_;
   std::vector<float> maxima_;
   std::vector<std::size_t> order_;
