@@ -129,7 +129,8 @@ TEST_CASE("view LOD: a camera inside the mesh, at its surface or far away gets a
   REQUIRE(local.ok());
   const std::vector<lod_camera> cams{look_at({0.0, 0.0, 0.0}, {1.0, 0.2, 0.1}),     // inside
                                      look_at({0.0, -1.0001, 0.0}, {0.0, 0.0, 0.0}),  // at the surface
-                                     look_at({0.0, -1e7, 3.0}, {0.0, 0.0, 0.0})};    // far away
+                                     look_at({0.0, -1e7, 3.0}, {0.0, 0.0, 0.0}),     // far away
+                                     look_at({0.0, -1e300, 3.0}, {0.0, 0.0, 0.0})};  // beyond float and a length's range
   for (lod_selection sel : {lod_selection::screen_error, lod_selection::paper}) {
     const contraction_hierarchy& h = sel == lod_selection::paper ? *local : s.h;
     auto lod = view_dependent_lod::create(h, s.table, {.selection = sel, .view = {}});

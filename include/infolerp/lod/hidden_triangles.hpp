@@ -113,7 +113,8 @@ inline view_frustum make_view_frustum(const lod_camera& cam) {
   const double tv = std::tan(0.5 * cam.vertical_fov);
   const double th = tv * static_cast<double>(cam.width) / static_cast<double>(cam.height);
   view_frustum v;
-  v.eye = cam.position, v.eye_f = glm::vec3(cam.position);
+  constexpr double big = std::numeric_limits<float>::max();  // a farther eye converts to the largest float
+  v.eye = cam.position, v.eye_f = glm::vec3(glm::clamp(cam.position, glm::dvec3(-big), glm::dvec3(big)));
   const glm::dvec3 inward[5] = {f, th * f - right, th * f + right, tv * f - up, tv * f + up};
   for (int k = 0; k < 5; ++k) v.inward[k] = inward[k], v.inward_f[k] = glm::vec3(inward[k]);
   return v;

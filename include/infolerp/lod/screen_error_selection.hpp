@@ -133,7 +133,10 @@ inline void pixels_per_unit(std::span<const view_patch> patches, const lod_camer
       if (away + spread < half_pi) weight = opt.hidden_weight;
       else if (away - spread > half_pi) weight = 1.0;
     }
-    k[g] = weight * focal / std::max({d - r, opt.near_fraction * r, 1e-300});
+    // Clamped to positive finite values: a camera farther than a double's length (d = inf) sees
+    // the coarsest level, not a 0 that budget_at would divide by.
+    k[g] = std::clamp(weight * focal / std::max({d - r, opt.near_fraction * r, 1e-300}), std::numeric_limits<double>::min(),
+                      std::numeric_limits<double>::max());
   }
 }
 
