@@ -36,15 +36,22 @@
 //   interleaved in one loop, each timed update and memcpy right after an untimed one (warm). Distances are left empty for frame rows. stdout also gives the
 //   update with openmp_executor{2} (checked to produce the same index buffer) and medians.
 //   kind=view (a second header line gives its columns: kind,mesh,method,fraction,view,triangles,
-//   psnr_db,ssim,weighted_distance,salient_distance,seconds), per mesh, fraction and camera:
+//   psnr_db,ssim,weighted_distance,salient_distance,seconds,psnr_self_db), per mesh, fraction and camera:
 //   cameras orbit0..7 (those of support/mesh_views.hpp, whole mesh in frame) and close0..7
 //   (between them, at 1.2 bounding radii from the box centre: the mesh overflows the frustum);
 //   methods infolerp (view_dependent_lod::frame with default options on the default hierarchy
 //   with backstop 0.005), infolerp_paper (lod_selection::paper on a cluster-local-first
 //   hierarchy) and meshoptimizer (meshopt_simplify of the whole mesh to the triangle count
 //   infolerp drew for that camera); the budget is the global prefix's contraction count for the
-//   fraction. psnr_db, ssim: that camera's 256x256 reference-shader image against the full
-//   mesh's; weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
+//   fraction; infolerp and infolerp_paper draw what the camera sees (frame()'s default culling),
+//   meshoptimizer the whole simplified mesh. psnr_db, ssim: that camera's 256x256
+//   reference-shader image against the full mesh's, primary hits and shading normals from the
+//   method's drawn triangles, shadow and AO rays against the full mesh for every method alike;
+//   (their back faces ignored, so that a coarse surface just inside the full one is not shadowed
+//   by it); psnr_self_db: those rays against the drawn triangles (both faces), against the full
+//   mesh's image made alike; weighted_distance and salient_distance measure the frame's whole
+//   cut (what it draws and what it culled) and, in meshoptimizer rows, meshopt_simplify to the
+//   cut's triangle count; weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
 //   over the 10% most salient vertices (d: distance to the simplified surface); seconds: one
 //   frame() or meshopt_simplify call.
 // stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios, and
@@ -329,27 +336,34 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
   std::sort(sorted.begin(), sorted.end());
   const double salient_cut = sorted[static_cast<std::size_t>(0.9 * static_cast<double>(sorted.size()))];
   const std::vector<support::camera> cams = view_cameras(m);
-  const support::mesh_view_options vopt;
+  const support::mesh_view_options vopt;  // shadow and AO rays against the drawn triangles
   const std::span<const std::uint32_t> original(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * nt);
-  std::vector<support::image> full;
+  support::mesh_view_options with_full = vopt;  // ... against the full mesh
+  with_full.occluders = original;
+  std::vector<support::image> full, full_self;
   for (const support::camera& c : cams) {
-    auto img = support::render_mesh_views(device, m.positions, original, std::span<const support::camera>(&c, 1), vopt);
-    if (!img) return void(std::fprintf(stderr, "views: %s\n", img.error().message().c_str()));
+    auto img = support::render_mesh_views(device, m.positions, original, std::span<const support::camera>(&c, 1), with_full);
+    auto self = support::render_mesh_views(device, m.positions, original, std::span<const support::camera>(&c, 1), vopt);
+    if (!img || !self) return void(std::fprintf(stderr, "views: %s\n", (img ? self : img).error().message().c_str()));
     full.push_back(std::move((*img)[0]));
+    full_self.push_back(std::move((*self)[0]));
   }
   std::printf("# %s view rows: hierarchy %.3f s, %u clusters\n", name.c_str(), build, p.clusters.count);
-  std::vector<std::uint32_t> out(contracted_index_bound(*h)), mo(3 * nt);
-  std::vector<index_range> ranges(h->cluster_count);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), mo(3 * nt), cut(out.size()), cutp(contracted_index_bound(*hp)),
+      mo_cut(3 * nt);
+  std::vector<index_range> ranges(h->cluster_count), cut_ranges(h->cluster_count);
+  contraction_workspace work = make_contraction_workspace(*h), workp = make_contraction_workspace(*hp);
   for (double f : {0.35, 0.10, 0.05, 0.01}) {
     if (g_view_fraction > 0.0 && std::abs(f - g_view_fraction) > 1e-9) continue;
     const auto target = static_cast<std::size_t>(std::lround(f * static_cast<double>(nt)));
-    double psnr_sum[3] = {0, 0, 0};
+    double psnr_sum[3] = {0, 0, 0}, worst = 1e30;
     for (std::size_t v = 0; v < cams.size(); ++v) {
       const lod_camera cam = to_lod_camera(cams[v], static_cast<std::uint32_t>(vopt.width));
       const std::string view = (v < 8 ? "orbit" : "close") + std::to_string(v % 8);
-      std::size_t drawn = 0;
+      std::size_t drawn = 0, cut_tris = 0;
+      double psnr_ours = 0.0;
       for (int method = 0; method < 3; ++method) {
-        std::span<const std::uint32_t> idx;
+        std::span<const std::uint32_t> idx, whole;  // drawn; the whole cut (for the distances)
         t0 = clk::now();
         if (method < 2) {
           view_dependent_lod& l = method == 0 ? *lod : *lodp;
@@ -357,7 +371,11 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
           auto st = l.frame(cam, std::min<std::uint64_t>(l.capacity(), prefix_for(hh, target)), out, ranges);
           if (!st.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), st.error().message().c_str()));
           idx = std::span<const std::uint32_t>(out.data(), st->indices);
-          if (method == 0) drawn = st->indices / 3;
+          std::vector<std::uint32_t>& c = method == 0 ? cut : cutp;
+          auto n = contract_indices(hh, l.stop_points(), method == 0 ? work : workp, c, cut_ranges);
+          if (!n.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), n.error().message().c_str()));
+          whole = std::span<const std::uint32_t>(c.data(), *n);
+          if (method == 0) drawn = st->indices / 3, cut_tris = *n / 3;
         } else {
           const auto* in = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
           const std::size_t k = meshopt_simplify(mo.data(), in, 3 * nt, &m.positions[0].x, m.vertex_count(), sizeof(glm::vec3),
@@ -365,22 +383,37 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
           idx = std::span<const std::uint32_t>(mo.data(), k);
         }
         const double sec = seconds_since(t0);
-        auto img = support::render_mesh_views(device, m.positions, idx, std::span<const support::camera>(&cams[v], 1), vopt);
-        if (!img) return void(std::fprintf(stderr, "views: %s\n", img.error().message().c_str()));
+        if (method == 2) {  // the distances at our cut's triangle count
+          const auto* in = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
+          const std::size_t k = meshopt_simplify(mo_cut.data(), in, 3 * nt, &m.positions[0].x, m.vertex_count(),
+                                                 sizeof(glm::vec3), 3 * cut_tris, std::numeric_limits<float>::max(), 0, nullptr);
+          whole = std::span<const std::uint32_t>(mo_cut.data(), k);
+        }
+        // The camera's picture: primary hits and normals from the drawn triangles, shadow and AO
+        // rays against the full mesh (as a shadow map or a separate BVH gives an engine); and
+        // the self-occluded picture (those rays against the drawn triangles too).
+        auto img = support::render_mesh_views(device, m.positions, idx, std::span<const support::camera>(&cams[v], 1), with_full);
+        auto self = support::render_mesh_views(device, m.positions, idx, std::span<const support::camera>(&cams[v], 1), vopt);
+        if (!img || !self) return void(std::fprintf(stderr, "views: %s\n", (img ? self : img).error().message().c_str()));
         auto sim = support::compare_views(*img, std::vector<support::image>{full[v]});
-        if (!sim) return void(std::fprintf(stderr, "views: %s\n", sim.error().message().c_str()));
-        const view_distances d = vertex_distances(m, p.saliency, salient_cut, idx);
+        auto sim_self = support::compare_views(*self, std::vector<support::image>{full_self[v]});
+        if (!sim || !sim_self) return void(std::fprintf(stderr, "views: comparison failed\n"));
+        const view_distances d = vertex_distances(m, p.saliency, salient_cut, whole);
         psnr_sum[method] += sim->psnr;
+        if (method == 0) psnr_ours = sim->psnr;
+        if (method == 2) worst = std::min(worst, psnr_ours - sim->psnr);
         static const char* names[] = {"infolerp", "infolerp_paper", "meshoptimizer"};
         for (std::FILE* o : {csv, stdout})
-          std::fprintf(o, "view,%s,%s,%.2f,%s,%zu,%.4f,%.6f,%.6g,%.6g,%.6g\n", name.c_str(), names[method], f, view.c_str(),
-                       idx.size() / 3, sim->psnr, sim->ssim, d.weighted, d.salient, sec);
+          std::fprintf(o, "view,%s,%s,%.2f,%s,%zu,%.4f,%.6f,%.6g,%.6g,%.6g,%.4f\n", name.c_str(), names[method], f,
+                       view.c_str(), idx.size() / 3, sim->psnr, sim->ssim, d.weighted, d.salient, sec, sim_self->psnr);
         std::fflush(csv);
       }
       if (v == 7 || v == 15) {
-        std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshoptimizer %.2f dB\n", name.c_str(), f,
-                    v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8);
-        psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0;
+        std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshoptimizer %.2f dB; infolerp - meshoptimizer "
+                    "mean %+.2f, worst view %+.2f dB\n",
+                    name.c_str(), f, v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8,
+                    (psnr_sum[0] - psnr_sum[2]) / 8, worst);
+        psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0, worst = 1e30;
       }
     }
   }
@@ -424,7 +457,8 @@ int pareto_lod(int argc, char** argv) {
   if (!csv) return std::fprintf(stderr, "cannot write %s\n", csv_path.c_str()), 1;
   std::fprintf(csv, "kind,mesh,method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr,ssim\n");
   if (views)
-    std::fprintf(csv, "kind,mesh,method,fraction,view,triangles,psnr_db,ssim,weighted_distance,salient_distance,seconds\n");
+    std::fprintf(csv, "kind,mesh,method,fraction,view,triangles,psnr_db,ssim,weighted_distance,salient_distance,seconds,"
+                 "psnr_self_db\n");
   std::vector<std::pair<std::string, std::string>> meshes;
   if (builtin)
     for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));

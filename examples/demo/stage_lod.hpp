@@ -14,9 +14,12 @@
 //     count, the seconds of the frame update or the meshopt_simplify call, the saliency-weighted
 //     mean distance and the Hausdorff distance to the full mesh (support/surface_distance.hpp),
 //     PSNR and SSIM against the full mesh's image of the same view (not the scene reference);
+//   - frame() draws what the camera sees (its default culling); every panel's shadow and AO rays
+//     go against the full mesh; the distances measure the frame's whole cut (drawn and culled)
+//     and, for meshoptimizer, meshopt_simplify to that cut's triangle count;
 //   - DIR/lod_orbit.png: six cameras around the mesh (mesh_views' circle of 6), each one's
 //     frame() at 5% with the default options; top row the triangles from that camera, bottom row
-//     the same triangles from the opposite camera. Both rows are headlight-shaded with the edges
+//     the same triangles from the opposite camera (the holes are what the camera culled). Both rows are headlight-shaded with the edges
 //     of the drawn triangles overlaid (where neighbouring pixels see different triangles), so a
 //     cut that follows the camera shows dense above and coarse below; labels and the printed
 //     lines give each camera's triangle count and the share of them facing it (against the
@@ -57,10 +60,11 @@ namespace detail {
 struct lod_panel {
   std::string method;
   double fraction = 1.0;
-  std::vector<std::uint32_t> indices;
+  std::vector<std::uint32_t> indices;  // drawn
   double seconds = 0.0;
   support::image img;
   std::string label;  // drawn into img once every comparison with the full mesh's image is done
+  std::vector<std::uint32_t> cut{};  // frame(): its whole cut, drawn and culled (the distances' mesh)
 };
 
 // The mesh the LOD stage simplifies: the first object of the first --mesh file, or the built-in torus.
@@ -91,6 +95,11 @@ inline status lod_frame(view_dependent_lod& lod, const contraction_hierarchy& h,
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!st) return st.error();
   p.indices.resize(st->indices);
+  contraction_workspace w = make_contraction_workspace(h);
+  p.cut.resize(contracted_index_bound(h));
+  auto n = contract_indices(h, lod.stop_points(), w, p.cut, ranges);
+  if (!n) return n.error();
+  p.cut.resize(*n);
   return {};
 }
 
@@ -113,7 +122,8 @@ inline bool finish_panel(demo_context& ctx, const support::embree_device& device
   }
   const stopwatch metric_watch;
   progress_line metric_line(std::string("LOD metric ") + tag);
-  const support::distances d = support::measure(m, saliency, p.indices, with_progress(ctx.options, metric_line));
+  const support::distances d =
+      support::measure(m, saliency, p.cut.empty() ? p.indices : p.cut, with_progress(ctx.options, metric_line));
   metric_line.finish();
   record_time(ctx, std::string("LOD metric ") + tag, metric_watch.seconds());
   r.weighted_distance = d.weighted, r.hausdorff = d.hausdorff;
@@ -194,7 +204,7 @@ inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, v
   for (unsigned k = 0; k < cameras; ++k) {
     const support::camera c = support::mesh_view_camera(k, cameras, m.positions);
     const support::camera behind = support::mesh_view_camera((k + cameras / 2) % cameras, cameras, m.positions);
-    lod_panel p{"infolerp", 0.05, {}, 0.0, {}, {}};
+    lod_panel p{"infolerp", 0.05, {}, 0.0, {}, {}, {}};
     if (auto s = lod_frame(lod, h, lod_eye(c, side), m.triangle_count(), p); !s) return report(s), false;
     std::vector<glm::uvec3> tris(p.indices.size() / 3);
     for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = {p.indices[3 * t], p.indices[3 * t + 1], p.indices[3 * t + 2]};
@@ -208,7 +218,7 @@ inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, v
     std::snprintf(text, sizeof text, "camera %u: azimuth %u deg, %s\ninfolerp 5%%: %zu triangles\n%.0f%% face it (full mesh %.0f%%)",
                   k, 360 * k / cameras, k % 2 == 0 ? "above" : "below", tris.size(), 100.0 * facing, 100.0 * facing_full);
     draw_label(images[k], 0, 0, text, label_scale(side));
-    std::snprintf(text, sizeof text, "camera %u's triangles\nfrom the opposite side", k);
+    std::snprintf(text, sizeof text, "camera %u's triangles\nfrom the opposite side:\nthe holes are what it culled", k);
     draw_label(images[cameras + k], 0, 0, text, label_scale(side));
     std::printf("  camera %u: %zu triangles, %.0f%% facing it (full mesh: %.0f%%)\n", k, tris.size(), 100.0 * facing,
                 100.0 * facing_full);
@@ -267,26 +277,32 @@ inline bool stage_lod(demo_context& ctx) {
   record_time(ctx, "LOD build (weights, hierarchy, table)", watch.seconds());
 
   const int side = std::max(16, std::min({ctx.options.width, ctx.options.height, 384}));
-  const support::mesh_view_options view{side, side, 1, ctx.options.shader, ctx.options.threads};
-  const support::camera cam = support::mesh_view_camera(0, 1, m.positions);
-  const support::embree_device device;
   const std::size_t nt = m.triangle_count();
   const auto* full_idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
-  detail::lod_panel full{"full", 1.0, {full_idx, full_idx + 3 * nt}, 0.0, {}, {}};
+  // Shadow and AO rays against the full mesh for every panel (frame() draws what the camera
+  // sees; the occluders come from elsewhere, as a shadow map or a BVH gives an engine).
+  support::mesh_view_options view{side, side, 1, ctx.options.shader, ctx.options.threads};
+  view.occluders = std::span<const std::uint32_t>(full_idx, 3 * nt);
+  const support::camera cam = support::mesh_view_camera(0, 1, m.positions);
+  const support::embree_device device;
+  detail::lod_panel full{"full", 1.0, {full_idx, full_idx + 3 * nt}, 0.0, {}, {}, {}};
   if (!detail::finish_panel(ctx, device, m, saliency, view, full, nullptr)) return false;
 
   std::vector<detail::lod_panel> panels;
   for (const double f : {0.35, 0.05}) {
-    detail::lod_panel ours{"infolerp", f, {}, 0.0, {}, {}};
+    detail::lod_panel ours{"infolerp", f, {}, 0.0, {}, {}, {}};
     if (auto s = detail::lod_frame(*lod, *h, detail::lod_eye(cam, side), nt, ours); !s) return report(s), false;
     if (!detail::finish_panel(ctx, device, m, saliency, view, ours, &full.img)) return false;
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
-    detail::lod_panel theirs{"meshoptimizer", f, std::vector<std::uint32_t>(3 * nt), 0.0, {}, {}};
+    detail::lod_panel theirs{"meshoptimizer", f, std::vector<std::uint32_t>(3 * nt), 0.0, {}, {}, {}};
     const auto t1 = std::chrono::steady_clock::now();
     const std::size_t k = meshopt_simplify(theirs.indices.data(), full_idx, 3 * nt, &m.positions[0].x, m.vertex_count(),
                                            sizeof(glm::vec3), ours.indices.size(), std::numeric_limits<float>::max(), 0, nullptr);
     theirs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     theirs.indices.resize(k);
+    theirs.cut.resize(3 * nt);  // the distances at the triangle count of our whole cut
+    theirs.cut.resize(meshopt_simplify(theirs.cut.data(), full_idx, 3 * nt, &m.positions[0].x, m.vertex_count(),
+                                       sizeof(glm::vec3), ours.cut.size(), std::numeric_limits<float>::max(), 0, nullptr));
     if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
 #else
     detail::lod_panel theirs;

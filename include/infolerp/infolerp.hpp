@@ -51,6 +51,7 @@
 #include "infolerp/lod/contraction_hierarchy.hpp"
 #include "infolerp/lod/view_selection.hpp"
 #include "infolerp/lod/screen_error_selection.hpp"
+#include "infolerp/lod/hidden_triangles.hpp"
 #include "infolerp/lod/vertex_contraction.hpp"
 #include "infolerp/lod/cluster_split.hpp"
 #include "infolerp/lod/cluster_local_indices.hpp"

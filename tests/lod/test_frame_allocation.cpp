@@ -1,6 +1,7 @@
 // The per-frame entry point and its 16-bit conversion allocate nothing after setup
 // (view_dependent_lod.hpp, cluster_local_indices.hpp): counted by replacing the global operator
 // new in this test executable.
+#include <algorithm>
 #include <vector>
 #include <catch2/catch.hpp>
 #include "infolerp/lod/cluster_local_indices.hpp"
@@ -13,7 +14,8 @@ TEST_CASE("a frame allocates nothing after setup", "[lod]") {
   using namespace infolerp;
   const indexed_mesh m = support::make_icosphere(3);
   std::vector<std::uint32_t> cl(m.triangle_count());
-  for (std::size_t t = 0; t < cl.size(); ++t) cl[t] = static_cast<std::uint32_t>(t % 5);
+  for (std::size_t t = 0; t < cl.size(); ++t)  // five bands across x, so that the cluster-local phase exists (paper)
+    cl[t] = std::min(4u, static_cast<std::uint32_t>(2.5f * (m.positions[m.triangles[t].x].x + 1.0f)));
   std::vector<double> sal(m.vertex_count(), 1.0), w(3 * m.triangle_count(), 1.0);
   auto h = make_contraction_hierarchy(m, w, cl, 5, {.cluster_local_first = true});
   REQUIRE(h.ok());

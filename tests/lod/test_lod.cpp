@@ -362,7 +362,8 @@ TEST_CASE("per-frame entry point: budgets, closedness, bad input", "[lod]") {
   REQUIRE(h.ok());
   auto table = compute_cluster_attributes(m, sal, cl, 8);
   REQUIRE(table.ok());
-  auto lod = view_dependent_lod::create(*h, *table, {.selection = lod_selection::paper, .view = {}});
+  // The whole cut (keep_hidden), to count its triangles and check that it is closed.
+  auto lod = view_dependent_lod::create(*h, *table, {.selection = lod_selection::paper, .view = {}, .keep_hidden = true});
   REQUIRE(lod.ok());
   std::vector<std::uint32_t> out(contracted_index_bound(*h));
   std::vector<index_range> ranges(8);

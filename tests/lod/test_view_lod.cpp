@@ -2,6 +2,8 @@
 // any valid camera gets a crack-free LOD, bad cameras get a clear status, zero saliency keeps
 // its planes (the weight floor of contraction_hierarchy.hpp).
 #include <algorithm>
+#include <array>
+#include <numbers>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -31,6 +33,15 @@ bool closed_and_manifold(std::span<const std::uint32_t> idx) {
     auto it = directed.find({e.second, e.first});
     if (n != 1 || it == directed.end() || it->second != 1) return false;
   }
+  return true;
+}
+
+// Whether the triangles of a (as corner triples) are among those of b, counted with multiplicity.
+bool is_sub_multiset(std::span<const std::uint32_t> a, std::span<const std::uint32_t> b) {
+  std::map<std::array<std::uint32_t, 3>, int> count;
+  for (std::size_t k = 0; k < b.size(); k += 3) ++count[{b[k], b[k + 1], b[k + 2]}];
+  for (std::size_t k = 0; k < a.size(); k += 3)
+    if (--count[{a[k], a[k + 1], a[k + 2]}] < 0) return false;
   return true;
 }
 
@@ -68,9 +79,12 @@ lod_camera look_at(const glm::dvec3& eye, const glm::dvec3& at) { return {eye, a
 TEST_CASE("view LOD: random cameras, inside the mesh included, get crack-free LODs within budget", "[lod]") {
   const sphere_lod s;
   auto lod = view_dependent_lod::create(s.h, s.table);
+  auto whole = view_dependent_lod::create(s.h, s.table, {.view = {}, .keep_hidden = true});
   REQUIRE(lod.ok());
-  std::vector<std::uint32_t> out(contracted_index_bound(s.h));
-  std::vector<index_range> ranges(8);
+  REQUIRE(whole.ok());
+  std::vector<std::uint32_t> out(contracted_index_bound(s.h)), cut_out(out.size());
+  std::vector<index_range> ranges(8), cut_ranges(8);
+  contraction_workspace w = make_contraction_workspace(s.h);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> pos(-3.0, 3.0), unit(-1.0, 1.0);
   std::uniform_int_distribution<std::uint64_t> budget(0, lod->capacity());
@@ -86,36 +100,54 @@ TEST_CASE("view LOD: random cameras, inside the mesh included, get crack-free LO
     lod_camera cam = look_at(eye, draw3(unit));
     if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-3) continue;
     const std::uint64_t r = k == 1 ? lod->capacity() : budget(rng);
+    INFO("camera " << k << ", budget " << r << " of " << lod->capacity());
+    // The whole cut (keep_hidden): closed and manifold, at least the budget's triangles.
+    auto all = whole->frame(cam, r, out, ranges);
+    if (!all.ok()) FAIL(all.error().message());
+    CHECK(closed_and_manifold(std::span<const std::uint32_t>(out.data(), all->indices)));
+    CHECK(all->indices / 3 >= all->triangle_budget);
+    if (r > 100) CHECK(all->indices < 3 * s.m.triangle_count());
+    // The default frame: a subset of its own cut, which is closed and manifold (no crack).
     auto st = lod->frame(cam, r, out, ranges);
     if (!st.ok()) FAIL(st.error().message());
-    INFO("camera " << k << ", budget " << r << " of " << lod->capacity());
-    CHECK(st->applied <= r);
-    CHECK(st->applied + lod->capacity() / 1000 + 8 >= st->budgeted);
-    const std::span<const std::uint32_t> idx(out.data(), st->indices);
-    CHECK(closed_and_manifold(idx));
-    if (r > 100) CHECK(st->indices < 3 * s.m.triangle_count());
+    auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, cut_ranges);
+    REQUIRE(cut.ok());
+    const std::span<const std::uint32_t> cut_idx(cut_out.data(), *cut);
+    CHECK(closed_and_manifold(cut_idx));
+    CHECK(is_sub_multiset(std::span<const std::uint32_t>(out.data(), st->indices), cut_idx));
+    // Inside the sphere every triangle faces away, and every one the frustum holds is drawn.
+    if (k % 4 == 0) CHECK(st->indices > 0);
     std::size_t sum = 0;
     for (const index_range& g : ranges) sum += g.count;
     CHECK(sum == st->indices);
   }
 }
 
-TEST_CASE("view LOD: a camera inside the mesh gets a LOD under either selection", "[lod]") {
+TEST_CASE("view LOD: a camera inside the mesh, at its surface or far away gets a LOD under either selection", "[lod]") {
   const sphere_lod s;
+  auto local = make_contraction_hierarchy(s.m, *weighting_map(s.m, s.sal, s.cl, 8), s.cl, 8, {.cluster_local_first = true});
+  REQUIRE(local.ok());
+  const std::vector<lod_camera> cams{look_at({0.0, 0.0, 0.0}, {1.0, 0.2, 0.1}),     // inside
+                                     look_at({0.0, -1.0001, 0.0}, {0.0, 0.0, 0.0}),  // at the surface
+                                     look_at({0.0, -1e7, 3.0}, {0.0, 0.0, 0.0}),     // far away
+                                     look_at({0.0, -1e300, 3.0}, {0.0, 0.0, 0.0})};  // beyond float and a length's range
   for (lod_selection sel : {lod_selection::screen_error, lod_selection::paper}) {
-    auto lod = view_dependent_lod::create(s.h, s.table, {.selection = sel, .view = {}});
+    const contraction_hierarchy& h = sel == lod_selection::paper ? *local : s.h;
+    auto lod = view_dependent_lod::create(h, s.table, {.selection = sel, .view = {}});
     REQUIRE(lod.ok());
-    std::vector<std::uint32_t> out(contracted_index_bound(s.h));
+    std::vector<std::uint32_t> out(contracted_index_bound(h));
     std::vector<index_range> ranges(8);
-    auto st = lod->frame(look_at({0.0, 0.0, 0.0}, {1.0, 0.2, 0.1}), lod->capacity() / 2, out, ranges);
-    if (!st.ok()) FAIL(st.error().message());
-    CHECK(st->indices < 3 * s.m.triangle_count());
-    CHECK(st->indices > 0);
-    CHECK(closed_and_manifold(std::span<const std::uint32_t>(out.data(), st->indices)));
+    for (std::size_t k = 0; k < cams.size(); ++k) {
+      INFO("selection " << static_cast<int>(sel) << ", camera " << k);
+      auto st = lod->frame(cams[k], lod->capacity() / 2, out, ranges);
+      if (!st.ok()) FAIL(st.error().message());
+      CHECK(st->indices < 3 * s.m.triangle_count());
+      CHECK(st->indices > 0);
+    }
   }
 }
 
-TEST_CASE("view LOD: bad cameras get a clear status", "[lod]") {
+TEST_CASE("view LOD: bad cameras get a clear status, legal extremes a LOD", "[lod]") {
   const sphere_lod s;
   auto lod = view_dependent_lod::create(s.h, s.table);
   REQUIRE(lod.ok());
@@ -136,18 +168,44 @@ TEST_CASE("view LOD: bad cameras get a clear status", "[lod]") {
   c = good, c.forward = glm::dvec3(0.0);
   CHECK(bad(c).code() == errc::bad_parameter);
   CHECK_THAT(bad(c).message(), Catch::Contains("forward"));
+  c = good, c.up = glm::dvec3(0.0);
+  CHECK_THAT(bad(c).message(), Catch::Contains("up vector is zero"));
   c = good, c.up = c.forward;
   CHECK_THAT(bad(c).message(), Catch::Contains("parallel"));
   c = good, c.vertical_fov = 0.0;
   CHECK_THAT(bad(c).message(), Catch::Contains("vertical_fov"));
+  c = good, c.vertical_fov = std::numbers::pi;
+  CHECK_THAT(bad(c).message(), Catch::Contains("vertical_fov"));
   c = good, c.vertical_fov = std::nan("");
   CHECK(bad(c).code() == errc::bad_parameter);
   CHECK(lod->frame(good, lod->capacity() + 1, out, ranges).error().code() == errc::bad_parameter);
+  // Any finite length of forward and up, and any fov below π, is a camera: the same frame as
+  // with unit vectors (the huge and tiny ones overflow or underflow a plain length).
+  auto ref = lod->frame(good, lod->capacity() / 2, out, ranges);
+  REQUIRE(ref.ok());
+  const std::vector<std::uint32_t> expected(out.begin(), out.begin() + static_cast<long>(ref->indices));
+  for (const double scale : {1e160, 1e300, 1e-200, 1e-310}) {
+    INFO("forward and up scaled by " << scale);
+    c = good, c.forward *= scale, c.up *= scale;
+    auto st = lod->frame(c, lod->capacity() / 2, out, ranges);
+    if (!st.ok()) FAIL(st.error().message());
+    CHECK(std::vector<std::uint32_t>(out.begin(), out.begin() + static_cast<long>(st->indices)) == expected);
+  }
+  c = good, c.vertical_fov = std::nextafter(std::numbers::pi, 0.0);
+  CHECK(lod->frame(c, lod->capacity() / 2, out, ranges).ok());
   CHECK(view_dependent_lod::create(s.h, s.table, {.view = {.hidden_weight = 0.0}}).error().code() == errc::bad_parameter);
   CHECK(view_dependent_lod::create(s.h, s.table, {.view = {.silhouette_weight = 0.5}}).error().code() == errc::bad_parameter);
+  const std::uint32_t nine = 9;
+  CHECK(view_dependent_lod::create(s.h, s.table, {.view = {}, .two_sided = std::span<const std::uint32_t>(&nine, 1)}).error().code() ==
+        errc::index_out_of_range);
   CHECK(make_contraction_hierarchy(s.m, std::vector<double>(3 * s.m.triangle_count(), 1.0), s.cl, 8, {.weight_floor = 2.0})
             .error()
             .code() == errc::bad_parameter);
+  // lod_selection::paper on a hierarchy without the cluster-local phase would be one global
+  // prefix whatever the camera: refused, naming what it needs.
+  auto paper = view_dependent_lod::create(s.h, s.table, {.selection = lod_selection::paper, .view = {}});
+  CHECK(paper.error().code() == errc::bad_parameter);
+  CHECK_THAT(paper.error().message(), Catch::Contains("cluster_local_first"));
 }
 
 TEST_CASE("view LOD: a flat L-shaped sheet, half of it of zero saliency, keeps its area at 50%", "[lod]") {
@@ -223,18 +281,30 @@ TEST_CASE("view LOD: four cameras around armadillo give four different crack-fre
   const std::size_t nt = m->triangle_count();
   std::uint64_t budget = 0;  // the global prefix's contractions down to 10% of the triangles
   for (std::size_t tris = nt; tris > nt / 10 && budget < lod->capacity(); ++budget) tris -= h->faces_removed[budget];
-  std::vector<std::uint32_t> out(contracted_index_bound(*h));
-  std::vector<index_range> ranges(cl->count);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), cut_out(out.size());
+  std::vector<index_range> ranges(cl->count), cut_ranges(cl->count);
+  contraction_workspace work = make_contraction_workspace(*h);
   std::vector<std::vector<std::uint32_t>> sets;
   for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)}) {
     const glm::dvec3 eye = box.center() + 1.5 * box.diagonal() * dir;
     auto st = lod->frame({eye, box.center() - eye, {0.0, 1.0, 0.0}, 0.7, 512, 512}, budget, out, ranges);
     if (!st.ok()) FAIL(st.error().message());
-    INFO("camera direction " << dir.x << " " << dir.y << " " << dir.z << ": " << st->indices / 3 << " triangles");
-    CHECK(st->applied <= budget);
-    CHECK(st->indices / 3 >= nt / 10);
-    CHECK(st->indices / 3 <= nt / 10 + nt / 100);
-    const std::span<const std::uint32_t> ours(out.data(), st->indices);
+    INFO("camera direction " << dir.x << " " << dir.y << " " << dir.z << ": " << st->indices / 3 << " triangles drawn, "
+                             << st->estimated << " estimated, budget " << st->triangle_budget);
+    // The budget counts the triangles drawn: the selection's estimate meets it, and the count
+    // drawn is within the estimate's error (a sample of 128 triangles per cluster).
+    CHECK(st->triangle_budget <= nt / 10);
+    CHECK(st->estimated >= st->triangle_budget);
+    CHECK(st->estimated <= st->triangle_budget + nt / 100);
+    CHECK(st->indices / 3 >= st->triangle_budget * 8 / 10);
+    CHECK(st->indices / 3 <= st->triangle_budget * 12 / 10);
+    // What is drawn is part of the frame's cut, which is closed and manifold (no crack).
+    auto cut = contract_indices(*h, lod->stop_points(), work, cut_out, cut_ranges);
+    REQUIRE(cut.ok());
+    const std::span<const std::uint32_t> cut_idx(cut_out.data(), *cut), ours(out.data(), st->indices);
+    CHECK(closed_and_manifold(cut_idx));
+    CHECK(is_sub_multiset(ours, cut_idx));
+    CHECK(st->indices < *cut);
     std::vector<std::uint32_t> sorted(ours.begin(), ours.end());
     std::sort(sorted.begin(), sorted.end());
     for (const auto& other : sets) CHECK(other != sorted);

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 #include "infolerp/mesh/adaptors.hpp"
 #include "infolerp/saliency/cluster_importance.hpp"
@@ -58,6 +59,26 @@ TEST_CASE("cluster attributes and per-view estimates by hand") {
   const double angle0 = std::acos(glm::dot(glm::normalize(c0.centroid - inside), c0.mean_normal));
   CHECK(near->area_estimate[0] == Approx(angle0 / d1 * 0.5));
   CHECK(std::isfinite(near->area_estimate[0]));
+}
+
+TEST_CASE("per-view estimates stay finite for huge but finite saliency") {
+  const auto m = two_triangles();
+  for (const double big : {1e120, 1e200, 1e307, std::numeric_limits<double>::max()}) {
+    INFO("saliency up to " << big);
+    const std::vector<double> sal{big, big, big, 0.5 * big, 0.25 * big, 1.0};
+    auto table = infolerp::compute_cluster_attributes(m, sal, std::vector<std::uint32_t>{0, 1}, 2);
+    REQUIRE(table.ok());
+    auto view = infolerp::estimate_view_importance(*table, {1.0 / 3, 1.0 / 3, 10.0});
+    REQUIRE(view.ok());
+    for (std::size_t k = 0; k < 2; ++k) {
+      CHECK(std::isfinite(view->importance_estimate[k]));
+      // Positive while the mesh's total saliency is finite (at DBL_MAX the sums overflow and a
+      // cluster's share of them is 0 or all).
+      if (big <= 1e307) CHECK(view->importance_estimate[k] > 0.0);
+    }
+    // The more salient cluster stays at least as important (both may reach the cap).
+    CHECK(view->importance_estimate[0] >= view->importance_estimate[1]);
+  }
 }
 
 TEST_CASE("budget distribution (eq. 9) by hand") {

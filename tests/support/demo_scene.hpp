@@ -102,6 +102,9 @@ struct scene_object {
 struct demo_scene {
   std::vector<scene_object> objects;
   embree_scene tracer;  // committed; geometry ids are indices into objects
+  // Shadow and AO rays go against this scene instead of `tracer` when set (e.g. the full mesh
+  // while `tracer` holds a LOD's drawn triangles); it must outlive the shaders.
+  const embree_scene* occluders = nullptr;
   camera view;
   sun_light sun;
   area_light area;

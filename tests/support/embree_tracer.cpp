@@ -107,6 +107,20 @@ embree_device::~embree_device() {
 
 // ---- scene ----------------------------------------------------------------------------------
 
+namespace {
+// Occlusion filter of embree_scene_options::occlude_front_faces_only: Embree's geometric normal
+// is the counter-clockwise one; a hit whose normal points along the ray is a back face.
+void reject_back_faces(const RTCFilterFunctionNArguments* args) {
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const float d = RTCHitN_Ng_x(args->hit, args->N, i) * RTCRayN_dir_x(args->ray, args->N, i) +
+                    RTCHitN_Ng_y(args->hit, args->N, i) * RTCRayN_dir_y(args->ray, args->N, i) +
+                    RTCHitN_Ng_z(args->hit, args->N, i) * RTCRayN_dir_z(args->ray, args->N, i);
+    if (d > 0.0f) args->valid[i] = 0;
+  }
+}
+}  // namespace
+
 embree_scene::embree_scene(const embree_device& device, const embree_scene_options& options)
     : device_(device.handle()) {
   INFOLERP_ASSERT(device_ != nullptr && "embree_scene built from a moved-from device");
@@ -115,6 +129,7 @@ embree_scene::embree_scene(const embree_device& device, const embree_scene_optio
   rtcSetSceneFlags(scene_, options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(scene_, options.quality);
   coherent_streams_ = options.coherent_streams;
+  front_faces_only_ = options.occlude_front_faces_only;
 }
 
 embree_scene::embree_scene(embree_scene&& other) noexcept
@@ -122,7 +137,8 @@ embree_scene::embree_scene(embree_scene&& other) noexcept
       scene_(std::exchange(other.scene_, nullptr)),
       geometry_count_(std::exchange(other.geometry_count_, 0)),
       committed_(std::exchange(other.committed_, false)),
-      coherent_streams_(other.coherent_streams_) {}
+      coherent_streams_(other.coherent_streams_),
+      front_faces_only_(other.front_faces_only_) {}
 
 embree_scene& embree_scene::operator=(embree_scene&& other) noexcept {
   if (this != &other) {
@@ -133,6 +149,7 @@ embree_scene& embree_scene::operator=(embree_scene&& other) noexcept {
     geometry_count_ = std::exchange(other.geometry_count_, 0);
     committed_ = std::exchange(other.committed_, false);
     coherent_streams_ = other.coherent_streams_;
+    front_faces_only_ = other.front_faces_only_;
   }
   return *this;
 }
@@ -173,6 +190,7 @@ result<std::uint32_t> embree_scene::add_triangles(std::span<const glm::vec3> pos
   static_assert(sizeof(glm::vec3) == 3 * sizeof(float) && sizeof(glm::uvec3) == 3 * sizeof(unsigned));
   std::memcpy(vertices, positions.data(), positions.size_bytes());
   std::memcpy(indices, triangles.data(), triangles.size_bytes());
+  if (front_faces_only_) rtcSetGeometryOccludedFilterFunction(geometry, reject_back_faces);
   rtcCommitGeometry(geometry);
   rtcAttachGeometryByID(scene_, geometry, geometry_count_);
   rtcReleaseGeometry(geometry);  // the scene holds it now

@@ -55,6 +55,10 @@ struct embree_scene_options {
   // 16-ray packets: Embree regroups the stream itself, which pays when the caller orders its
   // rays coherently (e.g. visibility_channel::coherent). Same answers per ray.
   bool coherent_streams = false;
+  // occluded() ignores hits on a triangle's back (geometric normal, counter-clockwise winding,
+  // along the ray): occlusion by closed meshes seen from outside, and no self-shadowing of a
+  // surface drawn just inside one (a LOD's triangles shadowed by the full mesh). intersect() is unchanged.
+  bool occlude_front_faces_only = false;
 };
 
 // A scene of triangle meshes that models infolerp::tracer, batch_occlusion_tracer and
@@ -107,6 +111,7 @@ class embree_scene {
   std::uint32_t geometry_count_ = 0;
   bool committed_ = false;
   bool coherent_streams_ = false;
+  bool front_faces_only_ = false;
 };
 
 static_assert(batch_occlusion_tracer<embree_scene> && batch_intersection_tracer<embree_scene>);

@@ -51,15 +51,31 @@ result<std::vector<image>> render_mesh_views(const embree_device& device, std::s
   if (opt.width <= 0 || opt.height <= 0 || cameras.empty())
     return make_error(errc::bad_parameter, no_element, "render_mesh_views: size ", opt.width, "x", opt.height, " and ",
                       cameras.size(), " views must be positive");
-  indexed_mesh m;
-  m.positions.assign(positions.begin(), positions.end());
-  m.triangles.resize(indices.size() / 3);
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    m.triangles[t] = {indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
-    for (int j = 0; j < 3; ++j)
-      if (m.triangles[t][j] >= positions.size())
-        return make_error(errc::index_out_of_range, t, "render_mesh_views: triangle ", t, " uses vertex ",
-                          m.triangles[t][j], " of ", positions.size());
+  auto mesh_of = [&](std::span<const std::uint32_t> idx) -> result<indexed_mesh> {
+    indexed_mesh m;
+    m.positions.assign(positions.begin(), positions.end());
+    m.triangles.resize(idx.size() / 3);
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      m.triangles[t] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
+      for (int j = 0; j < 3; ++j)
+        if (m.triangles[t][j] >= positions.size())
+          return make_error(errc::index_out_of_range, t, "render_mesh_views: triangle ", t, " uses vertex ",
+                            m.triangles[t][j], " of ", positions.size());
+    }
+    return m;
+  };
+  auto drawn = mesh_of(indices);
+  if (!drawn) return drawn.error();
+  indexed_mesh m = std::move(*drawn);
+  if (opt.occluders.size() % 3 != 0)
+    return make_error(errc::bad_size, opt.occluders.size(), "render_mesh_views: ", opt.occluders.size(),
+                      " occluder indices is not a multiple of 3");
+  embree_scene occluders{device, {.occlude_front_faces_only = true}};
+  if (!opt.occluders.empty()) {
+    auto occ = mesh_of(opt.occluders);
+    if (!occ) return occ.error();
+    if (auto id = occluders.add_mesh(*occ); !id) return id.error();
+    if (auto s = occluders.commit(); !s) return s;
   }
   const bounding_box box = box_of(positions);
   const double r = 0.5 * box.diagonal();
@@ -67,6 +83,7 @@ result<std::vector<image>> render_mesh_views(const embree_device& device, std::s
   if (auto id = tracer.add_mesh(m); !id) return id.error();
   if (auto s = tracer.commit(); !s) return s;
   demo_scene scene{std::move(tracer)};
+  if (!opt.occluders.empty()) scene.occluders = &occluders;
   scene.objects.push_back({"mesh", std::move(m), {texture_kind::solid, {0.75f, 0.72f, 0.68f}, {}, {1.0f, 1.0f}, 0.3f}});
   scene.ao_radius = static_cast<float>(0.4 * r);
   scene.ray_offset = static_cast<float>(1e-4 * r);

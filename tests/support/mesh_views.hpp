@@ -23,6 +23,12 @@ struct mesh_view_options {
   unsigned views = 8;
   shader_options shader{.ao_rays = 16, .soft_shadow_rays = 4};
   int threads = 0;  // render_reference's OpenMP threads (0: OpenMP's default)
+  // Triangles (over the same positions) the shadow and AO rays are traced against, their back
+  // faces ignored (a closed mesh occludes where a ray enters it, so a LOD's surface drawn just
+  // inside the full one does not shadow itself, as a shadow map's bias does); empty: the drawn
+  // ones, both faces. A LOD's picture with occlusion from the full mesh, as a shadow map or a
+  // separate BVH gives an engine.
+  std::span<const std::uint32_t> occluders{};
 };
 
 // Camera k of `views` around the bounding box of `positions` (the one render_mesh_views uses;

@@ -30,16 +30,17 @@ reference_shader::reference_shader(const demo_scene& scene, const shader_options
 }
 
 unsigned reference_shader::count_unoccluded(std::span<const ray> rays) const {
+  const embree_scene& tracer = scene_->occluders ? *scene_->occluders : scene_->tracer;
   unsigned visible = 0;
   if (options_.packets) {
     std::array<std::uint8_t, 64> occluded{};
     for (std::size_t base = 0; base < rays.size(); base += occluded.size()) {
       const std::size_t n = std::min(occluded.size(), rays.size() - base);
-      scene_->tracer.occluded(rays.subspan(base, n), std::span<std::uint8_t>(occluded.data(), n));
+      tracer.occluded(rays.subspan(base, n), std::span<std::uint8_t>(occluded.data(), n));
       for (std::size_t i = 0; i < n; ++i) visible += occluded[i] ? 0u : 1u;
     }
   } else {
-    for (const ray& r : rays) visible += scene_->tracer.occluded(r) ? 0u : 1u;
+    for (const ray& r : rays) visible += tracer.occluded(r) ? 0u : 1u;
   }
   return visible;
 }

@@ -29,7 +29,7 @@
 // Complexity: O(T log T) heap work plus O(valence²) per contraction, mostly scattered memory
 // accesses since the global order jumps across the mesh. Allocation: about 150 bytes per
 // triangle during the build; the result keeps 21 bytes per contraction, 12 per cross-cluster
-// dependency, 16 per triangle, 4 per vertex.
+// dependency, 16 per triangle, 16 per vertex (positions included).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -82,6 +82,8 @@ struct contraction_hierarchy {
   std::vector<std::uint32_t> indices, triangle_offsets;
   // Per triangle of that buffer: the contraction that removes it (invalid_id: none).
   std::vector<std::uint32_t> killer;
+  // Per vertex: its position (contractions keep positions), for view_dependent_lod's culling.
+  std::vector<glm::vec3> positions;
   std::uint32_t vertex_count = 0, cluster_count = 0;
   std::uint32_t local_contractions = 0;  // the first ones, that touch only their own cluster's vertices
 
@@ -97,7 +99,7 @@ struct contraction_hierarchy {
     return 4 * (removed.size() + target.size() + parent.size() + owner.size() + error.size() + removal_order.size() +
                 cluster_offsets.size() + cluster_contractions.size() + cross_offsets.size() + 3 * cross.size() +
                 indices.size() + triangle_offsets.size() + killer.size()) +
-           faces_removed.size();
+           faces_removed.size() + sizeof(glm::vec3) * positions.size();
   }
 };
 
@@ -460,6 +462,8 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
 
   contraction_hierarchy h;
   h.vertex_count = static_cast<std::uint32_t>(nv);
+  h.positions.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) h.positions[v] = glm::vec3(mesh_position(m, v));
   h.cluster_count = cluster_count;
   h.removal_order.assign(nv, invalid_id);
   std::vector<std::pair<std::uint32_t, cross_dependency>> crossing;  // (owner, entry), ascending order

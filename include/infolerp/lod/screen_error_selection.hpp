@@ -18,20 +18,24 @@
 //   silhouette_weight  the normals face both towards and away from the camera;
 //   1                  otherwise (the cluster faces the camera).
 // A cluster applies a prefix of its owned contractions (in global order): the longest whose
-// running maximum of √error · k_c is <= τ, so that budgets grow monotonically with τ. For a
-// target, τ is the largest value whose budgets sum to at most the target (bisection over the
-// bits of a double: 64 steps of O(C log n)), topped up to the target from the next larger τ.
-// Matching only adds contractions and grows with the target, so the target handed to this
-// step is bisected (at most 11 rounds: to 1/1024 of the budget) to a target whose matched sum
-// fits the budget. Where matching cannot fit the view's choice into half the budget (a cluster's
-// first contractions depend on many of the others'), the frame takes the global prefix of the
-// budget's length instead: it applies exactly the budget and needs no matching.
+// running maximum of √error · k_c is <= τ, so that budgets grow monotonically with τ. The frame
+// draws what each cluster keeps times its seen share s_c (1 when nothing is culled), so for a
+// count of triangles to draw, τ is the largest value whose seen removal Σ_c s_c · (triangles
+// c's budget removes) stays within Σ_c s_c·T_c minus that count (bisection over the bits of a
+// double: 64 steps of O(C log n)), topped up from the next larger τ. A cluster with s_c = 0
+// costs nothing drawn and takes the facing weight, so that it is not simplified past its
+// neighbours only to drag them through matching. Matching only adds contractions, so the goal
+// handed to this step is bisected (at most 11 rounds: to 1/1024) to one whose matched removal
+// stays within the goal. Where matching leaves less than half the removal to the view's choice
+// (a cluster's first contractions depend on many of the others'), the frame takes the longest
+// global prefix that draws the count instead (no matching needed).
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <span>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -58,20 +62,40 @@ struct view_weight_options {
   double near_fraction = 0.1;      // nearest distance, as a fraction of the cluster radius, > 0
 };
 
+// v divided by its largest absolute component (v itself when 0), so that lengths and cross
+// products of any finite vector neither overflow nor underflow. O(1).
+inline glm::dvec3 scaled_for_length(const glm::dvec3& v) {
+  const double m = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  return m > 0.0 ? v / m : v;
+}
+
 // Errors: a non-finite field, a zero forward vector, up parallel to forward, fov outside (0, π)
-// (bad_parameter, each named); a zero-size viewport (bad_size). O(1).
+// (bad_parameter, each named); a zero-size viewport (bad_size). Any finite length of forward and
+// up is fine (they are scaled before they are normalised). O(1).
 inline status check_camera(const lod_camera& cam) {
   if (!all_finite(cam.position)) return make_error(errc::bad_parameter, no_element, "camera position is not finite");
   if (!all_finite(cam.forward) || !all_finite(cam.up))
     return make_error(errc::bad_parameter, no_element, "camera forward or up vector is not finite");
-  if (!(glm::length(cam.forward) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera forward vector is zero");
-  if (!(glm::length(glm::cross(cam.forward, cam.up)) > 1e-12 * glm::length(cam.forward) * glm::length(cam.up)))
-    return make_error(errc::bad_parameter, no_element, "camera up vector is zero or parallel to forward");
-  if (!(cam.vertical_fov > 0.0 && cam.vertical_fov < 3.14159))
+  const glm::dvec3 f = scaled_for_length(cam.forward), u = scaled_for_length(cam.up);
+  if (!(glm::length(f) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera forward vector is zero");
+  if (!(glm::length(u) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera up vector is zero");
+  if (!(glm::length(glm::cross(f, u)) > 1e-12 * glm::length(f) * glm::length(u)))
+    return make_error(errc::bad_parameter, no_element, "camera up vector is parallel to forward");
+  if (!(cam.vertical_fov > 0.0 && cam.vertical_fov < std::numbers::pi))
     return make_error(errc::bad_parameter, no_element, "camera vertical_fov ", cam.vertical_fov, " must be in (0, pi)");
   if (cam.width == 0 || cam.height == 0)
     return make_error(errc::bad_size, no_element, "camera viewport ", cam.width, "x", cam.height, " is empty");
   return {};
+}
+
+// The camera's unit forward, right and up vectors. Preconditions: check_camera(cam) passed. O(1).
+struct camera_basis {
+  glm::dvec3 forward, right, up;
+};
+inline camera_basis make_camera_basis(const lod_camera& cam) {
+  const glm::dvec3 f = glm::normalize(scaled_for_length(cam.forward));
+  const glm::dvec3 right = glm::normalize(glm::cross(f, scaled_for_length(cam.up)));
+  return {f, right, glm::cross(right, f)};
 }
 
 // A region of the mesh as the view weight sees it.
@@ -86,8 +110,7 @@ struct view_patch {
 // passed, options in range, k.size() == patches.size(). O(patches), no allocation.
 inline void pixels_per_unit(std::span<const view_patch> patches, const lod_camera& cam, const view_weight_options& opt,
                             std::span<double> k) {
-  const glm::dvec3 f = glm::normalize(cam.forward);
-  const glm::dvec3 right = glm::normalize(glm::cross(f, cam.up)), up = glm::cross(right, f);
+  const auto [f, right, up] = make_camera_basis(cam);
   const double tv = std::tan(0.5 * cam.vertical_fov);
   const double th = tv * static_cast<double>(cam.width) / static_cast<double>(cam.height);
   const double focal = static_cast<double>(cam.height) / (2.0 * tv);
@@ -110,7 +133,10 @@ inline void pixels_per_unit(std::span<const view_patch> patches, const lod_camer
       if (away + spread < half_pi) weight = opt.hidden_weight;
       else if (away - spread > half_pi) weight = 1.0;
     }
-    k[g] = weight * focal / std::max({d - r, opt.near_fraction * r, 1e-300});
+    // Clamped to positive finite values: a camera farther than a double's length (d = inf) sees
+    // the coarsest level, not a 0 that budget_at would divide by.
+    k[g] = std::clamp(weight * focal / std::max({d - r, opt.near_fraction * r, 1e-300}), std::numeric_limits<double>::min(),
+                      std::numeric_limits<double>::max());
   }
 }
 
@@ -134,6 +160,24 @@ inline std::vector<float> cluster_error_maxima(const contraction_hierarchy& h) {
   return out;
 }
 
+// Per-cluster prefix sums of the triangles its owned contractions remove (faces_removed, aligned
+// with h.cluster_contractions). O(contractions), allocation: the result.
+inline std::vector<std::uint32_t> cluster_removed_faces(const contraction_hierarchy& h) {
+  std::vector<std::uint32_t> out(h.cluster_contractions.size());
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    std::uint32_t n = 0;
+    for (std::uint32_t j = h.cluster_offsets[c]; j < h.cluster_offsets[c + 1]; ++j)
+      out[j] = n += h.faces_removed[h.cluster_contractions[j]];
+  }
+  return out;
+}
+
+// Triangles the first b owned contractions of cluster c remove. O(1).
+inline std::uint64_t removed_at(const contraction_hierarchy& h, std::span<const std::uint32_t> faces, std::uint32_t c,
+                                std::uint64_t b) {
+  return b == 0 ? 0 : faces[h.cluster_offsets[c] + b - 1];
+}
+
 // Owned contractions of cluster c whose running maximum times k is <= tau. O(log n).
 inline std::uint64_t budget_at(const contraction_hierarchy& h, std::span<const float> maxima, std::uint32_t c, double k,
                                double tau) {
@@ -142,75 +186,132 @@ inline std::uint64_t budget_at(const contraction_hierarchy& h, std::span<const f
   return static_cast<std::uint64_t>(std::upper_bound(b, e, limit, [](double l, float x) { return l < static_cast<double>(x); }) - b);
 }
 
-// Per-cluster budgets summing to min(target, contractions) (see the top of the file). Returns
-// the sum. Preconditions: maxima = cluster_error_maxima(h); k and budget one per cluster, every
-// k finite and > 0. O(64 · C log n), no allocation.
-inline std::uint64_t budgets_for_target(const contraction_hierarchy& h, std::span<const float> maxima,
-                                        std::span<const double> k, std::uint64_t target, std::span<std::uint64_t> budget) {
+// Per-cluster budgets for the largest τ whose seen removal Σ_c share_c · removed_at(c, b_c)
+// stays within `goal` (see the top of the file), topped up from the budgets at the next larger
+// τ as far as the goal allows (none when even τ = 0 removes more). Returns the seen removal.
+// Preconditions: maxima = cluster_error_maxima(h), faces = cluster_removed_faces(h); k, share
+// and budget one per cluster, every k finite and > 0, shares in [0, 1]. O(64 · C log n), no
+// allocation.
+inline double budgets_for_removal(const contraction_hierarchy& h, std::span<const float> maxima,
+                                  std::span<const std::uint32_t> faces, std::span<const double> k,
+                                  std::span<const double> share, double goal, std::span<std::uint64_t> budget) {
+  auto seen = [&](std::uint32_t c, std::uint64_t b) { return share[c] * static_cast<double>(removed_at(h, faces, c, b)); };
   auto sum_at = [&](double tau) {
-    std::uint64_t s = 0;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += budget_at(h, maxima, c, k[c], tau);
+    double s = 0.0;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, budget_at(h, maxima, c, k[c], tau));
     return s;
   };
   // Non-negative doubles order like their bit patterns: bisect over the bits, keeping
-  // sum(hi) > target and sum(lo) <= target (none when sum(0) > target already).
+  // sum(lo) <= goal < sum(hi) (none when sum(0) > goal already).
   constexpr double inf = std::numeric_limits<double>::infinity();
   const std::uint64_t top = std::bit_cast<std::uint64_t>(inf);
   std::uint64_t lo = 0, hi = top;
   bool below_zero = false;
-  if (sum_at(inf) <= target) lo = top;
-  else if (sum_at(0.0) > target) below_zero = true, hi = 0;
+  if (sum_at(inf) <= goal) lo = top;
+  else if (sum_at(0.0) > goal) below_zero = true, hi = 0;
   while (!below_zero && lo != top && hi - lo > 1) {
     const std::uint64_t mid = lo + (hi - lo) / 2;
-    (sum_at(std::bit_cast<double>(mid)) <= target ? lo : hi) = mid;
+    (sum_at(std::bit_cast<double>(mid)) <= goal ? lo : hi) = mid;
   }
-  std::uint64_t sum = 0;
+  double sum = 0.0;
   for (std::uint32_t c = 0; c < h.cluster_count; ++c)
-    sum += budget[c] = below_zero ? 0 : budget_at(h, maxima, c, k[c], std::bit_cast<double>(lo));
+    sum += seen(c, budget[c] = below_zero ? 0 : budget_at(h, maxima, c, k[c], std::bit_cast<double>(lo)));
   if (lo == top) return sum;
-  for (std::uint32_t c = 0; c < h.cluster_count && sum < target; ++c) {
-    const std::uint64_t more = std::min(target - sum, budget_at(h, maxima, c, k[c], std::bit_cast<double>(hi)) - budget[c]);
-    budget[c] += more, sum += more;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    const std::uint64_t more = budget_at(h, maxima, c, k[c], std::bit_cast<double>(hi));
+    if (more <= budget[c]) continue;
+    if (share[c] <= 0.0) {  // costs nothing drawn
+      budget[c] = more;
+      continue;
+    }
+    // The most further contractions of c whose removal still fits the goal.
+    const double room = static_cast<double>(removed_at(h, faces, c, budget[c])) + (goal - sum) / share[c];
+    const auto b = faces.begin() + h.cluster_offsets[c];
+    const auto at = std::upper_bound(b + static_cast<long>(budget[c]), b + static_cast<long>(more), room,
+                                     [](double r, std::uint32_t f) { return r < static_cast<double>(f); });
+    const auto nb = static_cast<std::uint64_t>(at - b);
+    sum += seen(c, nb) - seen(c, budget[c]);
+    budget[c] = nb;
   }
   return sum;
 }
 
 struct selection_stats {
   std::uint64_t budgeted = 0, applied = 0;
+  double drawn = 0.0;       // the estimated triangles drawn: Σ share_c · (T_c − removed_c)
   std::uint32_t rounds = 0;  // budget-and-matching rounds
 };
 
-// The frame's stop points (see the top of the file), matched, applying at most `target`
-// contractions; k and budget are scratch (one per cluster). Preconditions: check_camera(cam)
-// passed, options in range, maxima = cluster_error_maxima(h), spans one per cluster.
-// O(11 · (64 · C log n + matching)), no allocation.
+// The frame's stop points (see the top of the file), matched, drawing an estimated `triangles`
+// (at least, to about 1/1024 of the triangles to remove): cluster c of T_c triangles draws
+// share_c of those it keeps. If matching leaves less than half the removal to the view's choice,
+// the longest global prefix of at most `prefix` contractions that draws as many. k and budget are
+// scratch (one per cluster). Preconditions: check_camera(cam) passed, options in range, maxima
+// = cluster_error_maxima(h), faces = cluster_removed_faces(h), spans one per cluster, shares in
+// [0, 1], prefix <= h.contraction_count(). O(12 · (64 · C log n + matching)), no allocation.
 inline selection_stats select_for_view(const contraction_hierarchy& h, std::span<const view_patch> patches,
-                                       std::span<const float> maxima, const lod_camera& cam,
-                                       const view_weight_options& opt, std::uint64_t target, std::span<double> k,
-                                       std::span<std::uint64_t> budget, std::span<std::uint32_t> stop) {
+                                       std::span<const float> maxima, std::span<const std::uint32_t> faces,
+                                       const lod_camera& cam, const view_weight_options& opt,
+                                       std::span<const double> share, std::uint64_t triangles, std::uint64_t prefix,
+                                       std::span<double> k, std::span<std::uint64_t> budget,
+                                       std::span<std::uint32_t> stop) {
   pixels_per_unit(patches, cam, opt, k);
+  // A cluster the camera cannot see costs no triangle drawn; simplifying it past its neighbours
+  // would only drag them coarser through matching, so it is weighted as if it faced the camera.
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+    if (share[c] == 0.0 && k[c] < std::numeric_limits<double>::max()) k[c] /= opt.hidden_weight;
+  double seen_total = 0.0;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+    seen_total += share[c] * static_cast<double>(h.triangle_offsets[c + 1] - h.triangle_offsets[c]);
+  const double goal = seen_total - static_cast<double>(triangles);
   selection_stats st;
-  auto run = [&](std::uint64_t t) {
-    st.budgeted = budgets_for_target(h, maxima, k, t, budget);
+  auto run = [&](double g) {
+    (void)budgets_for_removal(h, maxima, faces, k, share, g, budget);
+    st.budgeted = 0;
+    for (std::uint64_t b : budget) st.budgeted += b;
     (void)stop_points_from_budgets(h, budget, stop);  // budgets never exceed capacities
     match_neighbours(h, stop);
-    st.applied = applied_total(h, stop);
+    double removed = 0.0;
+    st.applied = 0;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+      const std::uint64_t a = applied_count(h, c, stop[c]);
+      st.applied += a;
+      removed += share[c] * static_cast<double>(removed_at(h, faces, c, a));
+    }
+    st.drawn = seen_total - removed;
     ++st.rounds;
-    return st.applied <= target;
+    return removed;
   };
-  if (run(target)) return st;
-  std::uint64_t lo = 0, hi = target;  // run(0) fits: nothing applied
-  bool at_lo = false;
-  while (hi - lo > std::max<std::uint64_t>(1, target / 1024)) {
-    const std::uint64_t mid = lo + (hi - lo) / 2;
-    at_lo = run(mid);
-    (at_lo ? lo : hi) = mid;
+  // Matching only adds contractions, so the goal handed to the budgets is bisected (to 1/1024)
+  // down to the largest whose matched removal stays within the goal: at least `triangles` drawn.
+  if (run(goal) > goal && goal > 0.0) {
+    double lo = 0.0, hi = goal;
+    bool at_lo = false;
+    while (hi - lo > std::max(1.0, goal / 1024.0)) {
+      const double mid = 0.5 * (lo + hi);
+      at_lo = run(mid) <= goal;
+      (at_lo ? lo : hi) = mid;
+    }
+    if (!at_lo) run(lo);
   }
-  if (!at_lo) run(lo);
-  if (st.applied < target / 2) {  // the global prefix (see the top of the file)
-    std::fill(stop.begin(), stop.end(), static_cast<std::uint32_t>(target));
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = applied_count(h, c, stop[c]);
-    st.budgeted = st.applied = target;
+  if (seen_total - st.drawn < 0.5 * goal) {  // the global prefix (see the top of the file)
+    auto removal_at = [&](std::uint32_t p) {
+      double removed = 0.0;
+      for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+        removed += share[c] * static_cast<double>(removed_at(h, faces, c, applied_count(h, c, p)));
+      return removed;
+    };
+    // The longest prefix, up to `prefix`, whose seen removal stays within the goal.
+    std::uint32_t lo = 0, hi = static_cast<std::uint32_t>(prefix);
+    while (lo < hi) {
+      const std::uint32_t mid = lo + (hi - lo + 1) / 2;
+      if (removal_at(mid) <= goal) lo = mid;
+      else hi = mid - 1;
+    }
+    std::fill(stop.begin(), stop.end(), lo);
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = applied_count(h, c, lo);
+    st.budgeted = st.applied = lo;
+    st.drawn = seen_total - removal_at(lo);
   }
   return st;
 }

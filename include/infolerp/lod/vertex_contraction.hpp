@@ -18,6 +18,10 @@
 // that dropped triangles leave and records each cluster's range (§IV.C binds one range per
 // cluster). Chunk boundaries depend only on the hierarchy and the grain, so the output has
 // identical bits for any executor.
+// contract_visible_indices also drops each triangle the camera cannot see (hidden_triangles.hpp),
+// one test per kept triangle in the same parallel pass; a first pass sums the signed crossings
+// of a ray from the eye with the closed parts' kept triangles, and back faces are kept when the
+// eye is inside.
 // One vertex map serves every cluster, so a vertex on a cluster border contracts the same way
 // in all of them (the paper ensures this with the shared-cluster texture).
 #include <algorithm>
@@ -30,6 +34,7 @@
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/hidden_triangles.hpp"
 
 namespace infolerp {
 
@@ -52,6 +57,7 @@ struct contraction_workspace {
   std::vector<std::uint32_t> chunk_cluster;  // per chunk
   std::vector<std::size_t> chunk_at;         // per chunk, this frame: output offset if nothing is dropped
   std::vector<std::uint32_t> chunk_count;    // per chunk, this frame: indices written
+  std::vector<std::int32_t> chunk_winding;   // per chunk, this frame (culling): signed crossings of a ray from the eye
   std::size_t grain = 0;
 };
 
@@ -77,6 +83,7 @@ inline contraction_workspace make_contraction_workspace(const contraction_hierar
   w.run_kept.assign(w.run_owner.size(), 0);
   w.chunk_at.assign(w.chunk_run.size(), 0);
   w.chunk_count.assign(w.chunk_run.size(), 0);
+  w.chunk_winding.assign(w.chunk_run.size(), 0);
   return w;
 }
 
@@ -95,16 +102,14 @@ inline void resolve_vertex_map(const contraction_hierarchy& h, std::span<const s
   }
 }
 
-// Algorithm 1: the frame's index buffer into out (at least contracted_index_bound(h) entries)
-// and one range per cluster. Returns the indices written. Errors: out too small or ranges not
-// one per cluster (bad_size), stop not one per cluster (bad_size). Preconditions: w from this
-// hierarchy; stop dependency-closed (see the top of the file). O(contractions + runs · log T +
-// kept triangles / threads + chunks), no allocation unless an error is returned; identical bits
-// for any executor.
-template <class E = serial_executor>
+namespace detail {
+// Algorithm 1 (see contract_indices), dropping the triangles hidden_triangle() finds hidden when
+// `view` is not null (one_sided: one flag per triangle of h.indices).
+template <class E>
 result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
-                                     contraction_workspace& w, std::span<std::uint32_t> out,
-                                     std::span<index_range> ranges, E&& exec = E{}) {
+                                     contraction_workspace& w, const view_frustum* view,
+                                     std::span<const std::uint8_t> one_sided, std::span<std::uint32_t> out,
+                                     std::span<index_range> ranges, E&& exec) {
   static_assert(check_executor<std::remove_cvref_t<E>>());
   if (out.size() < contracted_index_bound(h))
     return make_error(errc::bad_size, out.size(), "index buffer holds ", out.size(), " indices; ",
@@ -127,7 +132,24 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
   }
   const std::uint32_t* remap = w.remap.data();
   const std::uint32_t* src = h.indices.data();
+  const glm::vec3* pos = h.positions.data();
   std::uint32_t* dst = out.data();
+  bool back_faces_hidden = view != nullptr;
+  if (view && view->may_be_inside_closed()) {  // the eye inside a closed part of the cut sees its back faces: cull none
+    exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        std::int32_t n = 0;
+        const std::size_t end = std::min(w.chunk_begin[k + 1], w.run_kept[w.chunk_run[k]]);
+        for (std::size_t t = w.chunk_begin[k]; t < end; ++t)
+          if (one_sided[t])
+            n += eye_ray_crossing(*view, pos[remap[src[3 * t]]], pos[remap[src[3 * t + 1]]], pos[remap[src[3 * t + 2]]]);
+        w.chunk_winding[k] = n;
+      }
+    });
+    std::int64_t winding = 0;
+    for (std::size_t k = 0; k < w.chunk_run.size(); ++k) winding += w.chunk_winding[k];
+    back_faces_hidden = winding == 0;
+  }
   exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       std::uint32_t* o = dst + w.chunk_at[k];
@@ -136,7 +158,9 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
       for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
         const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
         o[0] = a, o[1] = bb, o[2] = c;
-        o += (a != bb && bb != c && a != c) ? 3 : 0;
+        const bool drawn = a != bb && bb != c && a != c &&
+                           !(view && hidden_triangle(*view, pos[a], pos[bb], pos[c], back_faces_hidden && one_sided[t] != 0));
+        o += drawn ? 3 : 0;
       }
       w.chunk_count[k] = static_cast<std::uint32_t>(o - o0);
     }
@@ -154,6 +178,36 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
   for (std::uint32_t c = 0; c < h.cluster_count; ++c)
     if (ranges[c].count == 0) ranges[c].first = static_cast<std::uint32_t>(at);
   return at;
+}
+}  // namespace detail
+
+// Algorithm 1: the frame's index buffer into out (at least contracted_index_bound(h) entries)
+// and one range per cluster. Returns the indices written. Errors: out too small or ranges not
+// one per cluster (bad_size), stop not one per cluster (bad_size). Preconditions: w from this
+// hierarchy; stop dependency-closed (see the top of the file). O(contractions + runs · log T +
+// kept triangles / threads + chunks), no allocation unless an error is returned; identical bits
+// for any executor.
+template <class E = serial_executor>
+result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
+                                     contraction_workspace& w, std::span<std::uint32_t> out,
+                                     std::span<index_range> ranges, E&& exec = E{}) {
+  return detail::contract_indices(h, stop, w, nullptr, {}, out, ranges, exec);
+}
+
+// The same without the triangles the camera of `view` cannot see (hidden_triangles.hpp):
+// one_sided holds closed_part_triangles(h.indices, h.positions), cleared where back faces may be
+// seen. Errors: those of contract_indices; one_sided not one per triangle or h without its
+// positions (bad_size). Cost: that of contract_indices plus a test per kept triangle.
+template <class E = serial_executor>
+result<std::size_t> contract_visible_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
+                                             contraction_workspace& w, const view_frustum& view,
+                                             std::span<const std::uint8_t> one_sided, std::span<std::uint32_t> out,
+                                             std::span<index_range> ranges, E&& exec = E{}) {
+  if (one_sided.size() != h.triangle_count() || h.positions.size() != h.vertex_count)
+    return make_error(errc::bad_size, one_sided.size(), "one_sided holds ", one_sided.size(), " flags for ",
+                      h.triangle_count(), " triangles and the hierarchy ", h.positions.size(), " positions for ",
+                      h.vertex_count, " vertices");
+  return detail::contract_indices(h, stop, w, &view, one_sided, out, ranges, exec);
 }
 
 }  // namespace infolerp

@@ -13,16 +13,24 @@
 //     budget beyond the local phase is a global prefix (every local contraction plus the first
 //     R_global − Σ local of the rest, the same for all clusters; a prefix of the global order
 //     needs no matching); then neighbour matching (view_selection.hpp).
-// Both then contract into the caller's index buffer (vertex_contraction.hpp).
+// Both then contract into the caller's index buffer (vertex_contraction.hpp), by default without
+// the triangles the camera cannot see (hidden_triangles.hpp: outside the frustum, or facing away
+// on a closed part of the mesh; never where back faces may be seen). The budget counts what is
+// drawn: R_global contractions stand for the triangles their global prefix keeps, and
+// screen_error spends them on the seen part, each cluster's seen share estimated from a sample
+// of its triangles (stats: estimated and drawn). keep_hidden draws the same cut whole, for a
+// shadow-map pass or a ray tracer's BVH (frame() from a light's camera is the light's own LOD).
+// paper needs a hierarchy with the cluster-local phase (create() refuses one without it).
 // Each step is usable on its own; this class keeps their buffers between frames, so frame()
 // allocates nothing after construction (unless it returns an error). Any valid camera gets a
-// LOD, inside the mesh or a cluster's bounding sphere included (screen_error: a cluster around
+// LOD, inside the mesh (its back faces are then drawn) or a cluster's bounding sphere included (screen_error: a cluster around
 // the camera is seen at a tenth of its radius; paper: eq. 6's fallback, 1 when no cluster has a
 // positive λ_dist).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -31,6 +39,7 @@
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/hidden_triangles.hpp"
 #include "infolerp/lod/screen_error_selection.hpp"
 #include "infolerp/lod/vertex_contraction.hpp"
 #include "infolerp/lod/view_selection.hpp"
@@ -40,6 +49,9 @@ namespace infolerp {
 
 struct lod_frame_stats {
   std::size_t indices = 0;              // indices written
+  std::uint64_t triangle_budget = 0;    // triangles the global prefix of the budget keeps (what the
+                                        // frame may draw; screen_error estimates what it draws)
+  std::uint64_t estimated = 0;          // screen_error: the triangles the selection expected to draw
   std::uint64_t budgeted = 0;           // Σ per-cluster budgets before matching (paper: = R_global)
   std::uint64_t applied = 0;            // contractions applied after matching (paper: >= budgeted;
                                         // screen_error: <= the frame's budget)
@@ -53,13 +65,21 @@ struct lod_options {
   view_weight_options view;   // screen_error only
   double lambda_perc = 0.02;  // paper only: eq. 9's portion, in (0, 1]
   std::size_t grain = 4096;   // triangles per parallel task of the contraction pass
+  // false (default): draw no triangle the camera cannot see (hidden_triangles.hpp), and spend
+  // the budget on the triangles drawn. true: the same cut with its hidden triangles drawn too
+  // (for a shadow-map pass or a ray tracer's BVH); screen_error then counts every kept triangle.
+  bool keep_hidden = false;
+  // Clusters whose back faces may be seen (never back-face culled); read by create() only.
+  std::span<const std::uint32_t> two_sided{};
 };
 
 class view_dependent_lod {
  public:
   // Keeps references to h and table (they must outlive this object). Errors: table with a
-  // different cluster count (bad_size), options outside their ranges (bad_parameter).
-  // Allocation O(V + clusters + T / grain + contractions).
+  // different cluster count (bad_size) or a hierarchy without positions (bad_size), options
+  // outside their ranges (bad_parameter), a two_sided cluster out of range (index_out_of_range),
+  // paper on a hierarchy without cluster-local contractions (bad_parameter).
+  // Allocation O(V + clusters + T + contractions); O(T log T) time.
   static result<view_dependent_lod> create(const contraction_hierarchy& h, const cluster_table& table,
                                            const lod_options& opt = {}) {
     if (table.clusters.size() != h.cluster_count)
@@ -72,6 +92,17 @@ class view_dependent_lod {
         !std::isfinite(v.silhouette_weight) || !(v.near_fraction > 0.0) || !std::isfinite(v.near_fraction))
       return make_error(errc::bad_parameter, no_element, "view weights: hidden ", v.hidden_weight, " must be in (0, 1], silhouette ",
                         v.silhouette_weight, " >= 1 and finite, near_fraction ", v.near_fraction, " > 0 and finite");
+    if (h.positions.size() != h.vertex_count)
+      return make_error(errc::bad_size, h.positions.size(), "hierarchy holds ", h.positions.size(), " positions for ",
+                        h.vertex_count, " vertices");
+    for (std::size_t k = 0; k < opt.two_sided.size(); ++k)
+      if (opt.two_sided[k] >= h.cluster_count)
+        return make_error(errc::index_out_of_range, k, "two_sided cluster ", opt.two_sided[k], " >= cluster count ",
+                          h.cluster_count);
+    if (opt.selection == lod_selection::paper && h.local_contractions == 0 && h.contraction_count() > 0)
+      return make_error(errc::bad_parameter, no_element,
+                        "lod_selection::paper needs a hierarchy built with cluster_local_first (this one has no "
+                        "cluster-local contractions: every budget would be one global prefix)");
     return view_dependent_lod(h, table, opt);
   }
 
@@ -84,7 +115,8 @@ class view_dependent_lod {
   // One frame. Errors: an invalid camera (check_camera: bad_parameter, or bad_size for an empty
   // viewport), global_contractions > capacity() (bad_parameter); out smaller than
   // contracted_index_bound or ranges not one per cluster (bad_size).
-  // screen_error: O(11 · (64 · C log n + matching) + contractions + kept triangles / threads);
+  // screen_error: O(12 · (64 · C log n + matching) + samples + coarsest triangles + contractions
+  // + kept triangles / threads);
   // paper: O(C log C + matching + contractions + kept triangles / threads).
   template <class E = serial_executor>
   result<lod_frame_stats> frame(const lod_camera& camera, std::uint64_t global_contractions,
@@ -95,17 +127,24 @@ class view_dependent_lod {
       return make_error(errc::bad_parameter, no_element, "global budget ", global_contractions,
                         " exceeds the hierarchy's ", capacity(), " contractions");
     lod_frame_stats st;
+    st.triangle_budget = kept_[global_contractions];
+    view_frustum view = make_view_frustum(camera);
+    view.closed_lo = closed_lo_, view.closed_hi = closed_hi_;
     if (opt_.selection == lod_selection::screen_error) {
-      const selection_stats sel = select_for_view(*h_, patches_, maxima_, camera, opt_.view, global_contractions, area_,
-                                                  budget_, stop_);
+      if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
+      else visible_shares(samples_, view, eye_outside_coarsest(samples_, view), share_);
+      const selection_stats sel = select_for_view(*h_, patches_, maxima_, faces_, camera, opt_.view, share_,
+                                                  st.triangle_budget, global_contractions, area_, budget_, stop_);
       st.budgeted = sel.budgeted, st.applied = sel.applied, st.matching_sweeps = sel.rounds;
+      st.estimated = static_cast<std::uint64_t>(std::max(0.0, std::round(sel.drawn)));
     } else {
       if (status s = paper_stop_points(camera.position, global_contractions); !s.ok()) return s;
       for (std::uint64_t b : budget_) st.budgeted += b;
       st.matching_sweeps = match_neighbours(*h_, stop_);
       st.applied = applied_total(*h_, stop_);
     }
-    auto n = contract_indices(*h_, stop_, work_, out, ranges, exec);
+    auto n = opt_.keep_hidden ? contract_indices(*h_, stop_, work_, out, ranges, exec)
+                              : contract_visible_indices(*h_, stop_, work_, view, one_sided_, out, ranges, exec);
     if (!n.ok()) return n.error();
     st.indices = *n;
     return st;
@@ -116,15 +155,28 @@ class view_dependent_lod {
       : h_(&h), table_(&table), opt_(opt), work_(make_contraction_workspace(h, opt.grain)) {
     const std::size_t c = h.cluster_count;
     area_.resize(c), importance_.resize(c), priority_.resize(c), order_.resize(c), budget_.resize(c), stop_.resize(c);
-    capacity_.resize(c);
+    capacity_.resize(c), share_.resize(c);
     for (std::uint32_t k = 0; k < h.cluster_count; ++k) capacity_[k] = h.local_capacity(k);
-    if (opt.selection == lod_selection::screen_error) patches_ = cluster_patches(table), maxima_ = cluster_error_maxima(h);
+    kept_.resize(h.contraction_count() + 1);
+    kept_[0] = h.triangle_count();
+    for (std::size_t i = 0; i < h.contraction_count(); ++i) kept_[i + 1] = kept_[i] - h.faces_removed[i];
+    if (opt.selection == lod_selection::screen_error)
+      patches_ = cluster_patches(table), maxima_ = cluster_error_maxima(h), faces_ = cluster_removed_faces(h);
+    if (!opt.keep_hidden) {
+      one_sided_ = closed_part_triangles(h.indices, h.positions);
+      for (std::uint32_t g : opt.two_sided)
+        std::fill(one_sided_.begin() + h.triangle_offsets[g], one_sided_.begin() + h.triangle_offsets[g + 1], 0);
+      samples_ = make_visibility_samples(h, one_sided_);
+      closed_part_bounds(h.indices, h.positions, one_sided_, closed_lo_, closed_hi_);
+    }
+    opt_.two_sided = {};
   }
   // Eqs. 5–9 (see the top of the file) into budget_ and stop_.
   status paper_stop_points(const glm::dvec3& camera, std::uint64_t global_contractions) {
     if (status s = estimate_view_importance(*table_, camera, area_, importance_); !s.ok()) return s;
     if (global_contractions <= h_->local_contractions) {
-      for (std::size_t k = 0; k < priority_.size(); ++k) priority_[k] = area_[k] * importance_[k];
+      for (std::size_t k = 0; k < priority_.size(); ++k)  // capped: a huge area times a huge importance overflows
+        priority_[k] = std::min(area_[k] * importance_[k], std::numeric_limits<double>::max());
       if (status s = distribute_contractions(priority_, capacity_, global_contractions, opt_.lambda_perc, order_, budget_);
           !s.ok())
         return s;
@@ -138,7 +190,12 @@ class view_dependent_lod {
   const cluster_table* table_;
   lod_options opt_;
   contraction_workspace work_;
-  std::vector<double> area_, importance_, priority_;  // screen_error: area_ holds k_c
+  std::vector<double> area_, importance_, priority_, share_;  // screen_error: area_ holds k_c
+  std::vector<std::uint64_t> kept_;                          // triangles the global prefix of i contractions keeps
+  std::vector<std::uint32_t> faces_;                         // cluster_removed_faces
+  std::vector<std::uint8_t> one_sided_;                      // per triangle of h.indices: back faces hidden
+  visibility_samples samples_;
+  glm::dvec3 closed_lo_{0.0}, closed_hi_{0.0};                // closed_part_bounds
   std::vector<view_patch> patches_;
   std::vector<float> maxima_;
   std::vector<std::size_t> order_;

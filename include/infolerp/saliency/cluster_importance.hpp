@@ -108,6 +108,17 @@ struct view_importance {
   std::vector<double> importance_estimate;  // I_est per cluster (eq. 8)
 };
 
+// Eq. 8's I_est = S_c · S_peak · S_mean / S_mesh, computed as (S_c / S_mesh) · (S_peak · S_mean)
+// with each factor capped at the largest double, so that huge but finite saliency (whose product
+// or sums overflow) gives a finite importance; 0 when S_mesh is 0. O(1).
+inline double importance_of(const cluster_attributes& c, double mesh_saliency) {
+  if (!(mesh_saliency > 0.0)) return 0.0;
+  constexpr double top = std::numeric_limits<double>::max();
+  double share = c.total_saliency / mesh_saliency;  // in [0, 1]; inf / inf: the cluster holds the overflow
+  if (std::isnan(share)) share = 1.0;
+  return std::min(top, std::min(share, 1.0) * std::min(top, c.peak_saliency * std::min(top, c.mean_saliency)));
+}
+
 // A_est and I_est of every cluster for a camera at camera_position, into caller-owned spans of
 // one entry per cluster. Errors: a non-finite camera position (bad_parameter), spans of the
 // wrong size (bad_size). Complexity O(clusters); no allocation unless an error is returned.
@@ -138,9 +149,7 @@ inline status estimate_view_importance(const cluster_table& table, const glm::dv
     if (lambda_dist > 0.0) last = lambda_dist;
     else lambda_dist = last;
     area_estimate[k] = lambda_angle / lambda_dist * c.area;
-    importance_estimate[k] = table.mesh_saliency > 0.0
-        ? c.total_saliency * c.peak_saliency * c.mean_saliency / table.mesh_saliency
-        : 0.0;
+    importance_estimate[k] = importance_of(c, table.mesh_saliency);
   }
   return {};
 }
