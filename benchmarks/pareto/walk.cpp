@@ -97,8 +97,9 @@ class reference_lighting {
 std::vector<glm::vec3> reference_image(const scene& sc, const infolerp::pinhole_camera& cam, const shade_fn& shade) {
   std::vector<glm::vec3> img(std::size_t(cam.width) * cam.height, glm::vec3(0.0f));
   infolerp::support::enable_flush_to_zero();
+  const infolerp::pinhole_frame frame = cam.frame();
   for (std::size_t p = 0; p < img.size(); ++p) {
-    const infolerp::ray r = cam.primary_ray(static_cast<std::uint32_t>(p % cam.width), static_cast<std::uint32_t>(p / cam.width));
+    const infolerp::ray r = frame.primary_ray(static_cast<std::uint32_t>(p % cam.width), static_cast<std::uint32_t>(p / cam.width));
     const infolerp::hit h = sc.intersect(r);
     if (h.valid()) img[p] = shade(r.origin + h.distance * r.direction, h.triangle);
   }
@@ -140,10 +141,11 @@ double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam
   const std::size_t n = std::size_t(cam.width) * cam.height;
   std::vector<infolerp::hit> hits(n);
   std::vector<infolerp::ray> rays(block);
+  const infolerp::pinhole_frame frame = cam.frame();  // as the agent does: the basis once, not per ray
   for (std::size_t begin = 0; begin < n; begin += block) {
     const std::size_t m = std::min(block, n - begin);
     for (std::size_t i = 0; i < m; ++i)
-      rays[i] = cam.primary_ray(static_cast<std::uint32_t>((begin + i) % cam.width),
+      rays[i] = frame.primary_ray(static_cast<std::uint32_t>((begin + i) % cam.width),
                                 static_cast<std::uint32_t>((begin + i) / cam.width));
     infolerp::trace_intersect(*sc.tracer, std::span<const infolerp::ray>(rays.data(), m),
                               std::span<infolerp::hit>(hits.data() + begin, m));

@@ -49,7 +49,6 @@
 #include <utility>
 #include <vector>
 #include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/executor.hpp"
@@ -58,45 +57,10 @@
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
 #include "infolerp/refine/nld_os_queue.hpp"
+#include "infolerp/refine/pinhole_camera.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 
 namespace infolerp {
-
-// A pinhole camera: pixel (x, y), y down, gets the ray through its centre.
-struct pinhole_camera {
-  glm::vec3 eye{0.0f, 0.0f, 1.0f};     // camera position
-  glm::vec3 target{0.0f};              // looked-at point
-  glm::vec3 up{0.0f, 1.0f, 0.0f};      // world up (not parallel to target - eye)
-  float vertical_fov_degrees = 60.0f;  // full vertical field of view
-  std::uint32_t width = 320;           // image width in pixels
-  std::uint32_t height = 240;          // image height in pixels
-
-  // d / |d|: glm::normalize where the squared length is a normal float (so ordinary cameras keep
-  // their bits), scaled by the largest component first where it over- or underflows; (0,0,0)
-  // for a zero or non-finite d.
-  [[nodiscard]] static glm::vec3 unit(const glm::vec3& d) {
-    const float l2 = glm::dot(d, d);
-    if (std::isfinite(l2) && l2 >= std::numeric_limits<float>::min()) return glm::normalize(d);
-    const float scale = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-    return scale > 0.0f && std::isfinite(scale) ? glm::normalize(d / scale) : glm::vec3(0.0f);
-  }
-  // The unit view direction; (0,0,0) when eye and target coincide or target - eye overflows.
-  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) { return unit(target - eye); }
-
-  [[nodiscard]] ray primary_ray(std::uint32_t x, std::uint32_t y) const {
-    const glm::vec3 f = forward(eye, target);
-    const glm::vec3 r = unit(glm::cross(f, up));
-    const glm::vec3 u = glm::cross(r, f);
-    const float h = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
-    const float aspect = float(width) / float(height);
-    const float sx = (2.0f * (float(x) + 0.5f) / float(width) - 1.0f) * h * aspect;
-    const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(height)) * h;
-    ray out;
-    out.origin = eye;
-    out.direction = glm::normalize(f + sx * r + sy * u);
-    return out;
-  }
-};
 
 // What the shading callback gets for one vertex.
 struct shading_point {
@@ -109,7 +73,7 @@ struct shading_point {
 
 struct stage_figures {
   std::size_t triangles = 0;           // Δ: leaves shown
-  std::size_t triangles_total = 0;     // Δ_total: triangles ever shown
+  std::size_t triangles_total = 0;     // Δ_total: triangles sent to the visualizer since the view was set (Table 1)
   std::size_t triangles_produced = 0;  // every triangle the hierarchy holds
   std::size_t shading_samples = 0;     // vertices shaded so far
   double seconds = 0.0;                // wall time since the run started
@@ -505,6 +469,14 @@ class progressive_refiner {
     return {};
   }
 
+  // The rays a camera makes: its frame computed once (pinhole_camera::frame()) when it has one,
+  // else the camera itself.
+  template <class Camera>
+  static decltype(auto) rays_of(const Camera& camera) {
+    if constexpr (requires { camera.frame(); }) return camera.frame();
+    else return (camera);
+  }
+
   // Traces and checks the view; only then (optionally) restarts and takes the view.
   template <class T, class Camera, class E>
   status view(const T& tracer, const Camera& camera, E&& exec, bool restart) {
@@ -527,10 +499,11 @@ class progressive_refiner {
     hits.resize(n);
     for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
       std::array<ray, primary_block> rays;  // on the stack: no allocation per chunk
+      const auto& cam = rays_of(camera);
       for (std::size_t b = begin; b < end; b += primary_block) {
         const std::size_t m = std::min(primary_block, end - b);
         for (std::size_t i = 0; i < m; ++i)
-          rays[i] = camera.primary_ray(static_cast<std::uint32_t>((b + i) % width), static_cast<std::uint32_t>((b + i) / width));
+          rays[i] = cam.primary_ray(static_cast<std::uint32_t>((b + i) % width), static_cast<std::uint32_t>((b + i) / width));
         trace_intersect(tracer, std::span<const ray>(rays.data(), m), std::span<hit>(hits.data() + b, m));
       }
     });
