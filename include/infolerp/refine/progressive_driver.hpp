@@ -40,6 +40,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <concepts>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -48,6 +49,7 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -391,7 +393,8 @@ class progressive_refiner {
     return {};
   }
 
-  // The current image: per pixel the colours of the shown triangle over it interpolated, or the
+  // The current image: per pixel the colours of the shown triangle over it interpolated (each
+  // channel kept within its corners' range, so inside the range of what was delivered), or the
   // background. Preconditions: image.size() == width·height, a view was set. O(pixels), no
   // allocation.
   void reconstruct(std::span<glm::vec3> image) const {
@@ -429,6 +432,7 @@ class progressive_refiner {
     f.vertex_luminance = luminance_;
     f.l_max = l_max_;
     f.view_samples = view_requests_;
+    f.projection = has_projection_ ? &projection_ : nullptr;
     return f;
   }
 
@@ -567,6 +571,8 @@ class progressive_refiner {
   void apply_view(const Camera& camera, const std::vector<hit>& hits, E&& exec,
                   std::chrono::steady_clock::time_point began) {
     started_ = began;
+    if constexpr (requires { { camera.frame() } -> std::convertible_to<pinhole_frame>; }) projection_ = camera.frame(), has_projection_ = true;
+    else has_projection_ = false;
     width_ = camera.width;
     height_ = camera.height;
     finished_ = false;
@@ -636,7 +642,10 @@ class progressive_refiner {
     if (d == invalid_id) return options_.background;
     const glm::uvec3 v = mesh_.triangle(d).vertices;
     const glm::vec3 w = d == leaf ? pixel_weights_[p] : weights_in(d, leaf, pixel_weights_[p]);
-    return w.x * colour_[v.x] + w.y * colour_[v.y] + w.z * colour_[v.z];
+    const glm::vec3 a = colour_[v.x], b = colour_[v.y], c = colour_[v.z];
+    // Inside the corners' range, as exact interpolation is: the stored weights' rounding (a few
+    // ulps per re-location) must not carry a pixel past what was delivered.
+    return glm::clamp(w.x * a + w.y * b + w.z * c, glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)));
   }
   // The barycentric weights in ancestor a of the point with weights w in leaf l (planar).
   [[nodiscard]] glm::vec3 weights_in(std::uint32_t a, std::uint32_t l, glm::vec3 w) const {
@@ -1070,6 +1079,8 @@ class progressive_refiner {
   driver_options options_;
   criterion_state state_;
   std::uint32_t width_ = 0, height_ = 0;
+  pinhole_frame projection_;     // the view's camera, when it is a pinhole one (NLD_IS's projected areas)
+  bool has_projection_ = false;
   std::vector<std::uint32_t> pixel_leaf_;
   std::vector<glm::vec3> pixel_weights_;
   std::vector<std::uint32_t> leaf_pixels_;

@@ -288,6 +288,16 @@ class subdivision_mesh {
   [[nodiscard]] const subdivision_triangle& triangle(std::size_t t) const { return tris_[t]; }
   [[nodiscard]] std::span<const subdivision_triangle> triangles() const noexcept { return tris_; }
   [[nodiscard]] bool is_leaf(std::size_t t) const { return tris_[t].is_leaf(); }
+  // Whether a 1:4 split of t gives children whose corners are distinct in float: every edge's
+  // midpoint, as a split computes it, differs from both ends and from the other midpoints. False
+  // once t is so small against its coordinates that halving an edge no longer moves (about 23
+  // levels below a triangle of the size of its coordinates); refinement stops there. O(1).
+  [[nodiscard]] bool splittable(std::uint32_t t) const {
+    const glm::uvec3 v = tris_[t].vertices;
+    const glm::vec3 a = positions_[v.x], b = positions_[v.y], c = positions_[v.z];
+    const glm::vec3 m0 = midpoint(a, b), m1 = midpoint(b, c), m2 = midpoint(c, a);
+    return m0 != a && m0 != b && m1 != b && m1 != c && m2 != c && m2 != a && m0 != m1 && m1 != m2 && m2 != m0;
+  }
   // The midpoint vertex of edge (a, b), or invalid_id.
   [[nodiscard]] std::uint32_t edge_midpoint(std::uint32_t a, std::uint32_t b) const noexcept {
     return edges_.midpoint(a, b);
@@ -485,6 +495,9 @@ class subdivision_mesh {
     else if (k == 1) w1 = a, w2 = b, w0 = c;
     else w2 = a, w0 = b, w1 = c;
   }
+  // Halves first: the sum of two coordinates near ±FLT_MAX overflows (a fuzz find); for
+  // normal numbers the result is the same bits as 0.5 * (a + b).
+  static glm::vec3 midpoint(glm::vec3 a, glm::vec3 b) noexcept { return 0.5f * a + 0.5f * b; }
   static constexpr std::uint32_t closure_only = std::numeric_limits<std::uint32_t>::max() / 2;
 
   // Barycentric weights of vertex v's position in original triangle t (least squares in the
@@ -549,9 +562,7 @@ class subdivision_mesh {
     const auto m = static_cast<std::uint32_t>(positions_.size());
     e.midpoint = m;
     if (e.face[0] != invalid_id) queue_.push_back({e.face[0], depth + 1});
-    // Halves first: the sum of two coordinates near ±FLT_MAX overflows (a fuzz find); for
-    // normal numbers the result is the same bits as 0.5 * (a + b).
-    positions_.push_back(0.5f * positions_[a] + 0.5f * positions_[b]);
+    positions_.push_back(midpoint(positions_[a], positions_[b]));
     vertex_source_.push_back(tris_[t].original);
     return m;
   }
