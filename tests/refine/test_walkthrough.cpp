@@ -488,3 +488,24 @@ TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the curr
   // A revisited view sends only what changed: the last frame is the first one's camera.
   CHECK(r.report().stage2.triangles_total < r.report().stage2.triangles);
 }
+
+TEST_CASE("walkthrough: memory_bytes covers the hierarchy, the cache and the view, and grows with refinement") {
+  auto r = make_agent();
+  REQUIRE(r.set_view(scene(), support::walkthrough_path(0, FRAMES, W, H)).ok());
+  r.shade_requests(shader(), serial_executor{});
+  // A floor from the sizes alone: two copies of the hierarchy's triangles and positions (the
+  // mesh and the one start() returns to), 12 bytes of colour and 1 of state per vertex, 4 bytes
+  // of leaf and 12 of weights per pixel.
+  const auto floor = [&] {
+    const subdivision_mesh& m = r.mesh();
+    return 2 * (m.original_triangle_count() * sizeof(subdivision_triangle)) + m.triangle_count() * sizeof(subdivision_triangle) +
+           m.vertex_count() * (sizeof(glm::vec3) + sizeof(glm::vec3) + 1) + std::size_t(W) * H * 16;
+  };
+  const std::size_t before = r.memory_bytes();
+  CHECK(before >= floor());
+  while (r.refine(shader(), {.batches = 4}) == refine_progress::refined) {
+  }
+  REQUIRE(r.mesh().triangle_count() > 4 * scene().mesh.triangles.size());
+  CHECK(r.memory_bytes() >= floor());
+  CHECK(r.memory_bytes() > before);
+}

@@ -34,6 +34,10 @@ class nld_os_queue {
     heap_.clear();
     forced_.clear();
   }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return (pending_.capacity() + forced_.capacity()) * sizeof(std::uint32_t) + heap_.capacity() * sizeof(entry) +
+           taken_.capacity() * sizeof(scored);
+  }
   // Leaf t gained pixels in the current view; its key is taken at the next select().
   void add(std::uint32_t t) { pending_.push_back(t); }
 

@@ -152,6 +152,7 @@ class id_set {
     sorted_ = sorted_ && i == ids_.size();
   }
   [[nodiscard]] std::size_t size() const noexcept { return ids_.size(); }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept { return (ids_.capacity() + pos_.capacity()) * sizeof(std::uint32_t); }
   [[nodiscard]] std::span<const std::uint32_t> unordered() const noexcept { return ids_; }
   // O(n log n) after a change that broke the order, O(1) otherwise.
   [[nodiscard]] std::span<const std::uint32_t> sorted() const {
@@ -418,6 +419,18 @@ class progressive_refiner {
   // Shaded values held now, and samples delivered since start() (evicted ones shaded again count twice).
   [[nodiscard]] std::size_t cached_samples() const noexcept { return shaded_count_; }
   [[nodiscard]] std::size_t samples_delivered() const noexcept { return samples_; }
+  // Bytes the refiner holds: the hierarchy (and the copy start() returns to), the cache and the
+  // per-triangle, per-vertex and per-view buffers, by capacity. O(1).
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    const auto b = [](const auto&... v) { return ((v.capacity() * sizeof(typename std::remove_cvref_t<decltype(v)>::value_type)) + ...); };
+    return initial_mesh_.memory_bytes() + mesh_.memory_bytes() + nld_os_.memory_bytes() + visible_.memory_bytes() +
+           shown_.memory_bytes() +
+           b(pixel_leaf_, pixel_weights_, leaf_pixels_, in_view_, display_of_, decision_, decided_, shown_mark_, leaf_head_,
+             pixel_next_, fresh_, split_, green_first_, lum_tree_, tree_level_, tree_next_, dirty_, dirty_mark_, shown_above_,
+             merged_, scratch_, shown_count_, waiters_, waiter_head_, waiter_clock_, touched_, seeds_, stack_, vstate_,
+             colour_, luminance_, last_seen_, delivered_epoch_, to_issue_, in_sent_, listed_, changed_, path_, evict_,
+             selected_);
+  }
   // The frame the criteria see (pixel luminances filled only for NLD_IS).
   [[nodiscard]] refinement_frame frame() const {
     refinement_frame f;

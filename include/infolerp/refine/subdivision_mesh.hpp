@@ -91,6 +91,7 @@ class edge_table {
     if (cap > slots_.size()) rehash(cap);
   }
   [[nodiscard]] std::size_t size() const noexcept { return count_; }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept { return slots_.capacity() * sizeof(entry); }
 
   [[nodiscard]] const entry* find(std::uint32_t a, std::uint32_t b) const noexcept {
     if (slots_.empty()) return nullptr;
@@ -288,6 +289,12 @@ class subdivision_mesh {
   [[nodiscard]] const subdivision_triangle& triangle(std::size_t t) const { return tris_[t]; }
   [[nodiscard]] std::span<const subdivision_triangle> triangles() const noexcept { return tris_; }
   [[nodiscard]] bool is_leaf(std::size_t t) const { return tris_[t].is_leaf(); }
+  // Bytes held by the hierarchy: triangles, vertices, the edge table and the closure's queue
+  // (capacities, so what the allocator holds). O(1).
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return tris_.capacity() * sizeof(subdivision_triangle) + positions_.capacity() * sizeof(glm::vec3) +
+           vertex_source_.capacity() * sizeof(std::uint32_t) + edges_.memory_bytes() + queue_.capacity() * sizeof(pending);
+  }
   // Whether a 1:4 split of t gives children whose corners are distinct in float: every edge's
   // midpoint, as a split computes it, differs from both ends and from the other midpoints. False
   // once t is so small against its coordinates that halving an edge no longer moves (about 23
