@@ -1,12 +1,13 @@
 // infolerp_pareto walk --csv FILE [--width W --height H --frames N --loop P --shader simple|reference]
-//                      [--long-path [--blocks B] [--cache-bound C]]
+//                      [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]
 //
 // The walkthrough of Oliveira, Santos, Proença (§2, §4.1) on the procedural walkthrough scene:
 // a path of N frames from the street view into the temple view and back the same way
 // (support::walkthrough_path); with --loop P the path is P frames long and walked again and
 // again for N frames. With --long-path the scene is a street of B repeated blocks
 // (support::make_long_street_scene, default 26) walked from the first block to the last in N
-// frames, never coming back, with nld_os_cached alone (its cache bounded to C samples if given)
+// frames, never coming back, with nld_os_cached alone (its cache bounded to C samples and its
+// hierarchy to T triangles if given: progressive_refiner prunes what is out of view)
 // and the PSNR taken every 10th frame. Three methods, every one in this run:
 //   nld_os_cached   one agent; set_view() per frame, hierarchy and shading cache kept;
 //   nld_os_restart  start() per frame (hierarchy and cache thrown away);
@@ -114,7 +115,8 @@ std::vector<glm::vec3> reference_image(const scene& sc, const infolerp::pinhole_
 }
 
 infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_criterion c,
-                                        std::size_t cache_bound = std::numeric_limits<std::size_t>::max()) {
+                                        std::size_t cache_bound = std::numeric_limits<std::size_t>::max(),
+                                        std::size_t hierarchy_bound = std::numeric_limits<std::size_t>::max()) {
   auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   infolerp::driver_options o;
   o.criteria.criterion = c;
@@ -123,6 +125,7 @@ infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_c
   o.criteria.min_pixels = 6.0f;
   o.criteria.always_refine_fraction = 0.02f;
   o.max_cached_samples = cache_bound;
+  o.max_hierarchy_triangles = hierarchy_bound;
   auto r = sub.ok() ? infolerp::progressive_refiner::create(std::move(*sub), o)
                     : infolerp::result<infolerp::progressive_refiner>(sub.error());
   if (!r) {
@@ -229,9 +232,11 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
 
 // --long-path's report: memory and agent time along a walk that never comes back.
 int report_long_path(const std::vector<frame_row>& rows, std::uint32_t frames, std::uint32_t blocks, std::uint32_t width,
-                     std::uint32_t height, std::size_t cache_bound, const std::string& csv_path) {
-  std::printf("walk --long-path: %u frames at %ux%u down a street of %u blocks, nld_os_cached, cache bound %s\n", frames,
-              width, height, blocks, cache_bound == std::numeric_limits<std::size_t>::max() ? "none" : std::to_string(cache_bound).c_str());
+                     std::uint32_t height, std::size_t cache_bound, std::size_t hierarchy_bound, const std::string& csv_path) {
+  const auto bound = [](std::size_t b) { return b == std::numeric_limits<std::size_t>::max() ? std::string("none") : std::to_string(b); };
+  std::printf("walk --long-path: %u frames at %ux%u down a street of %u blocks, nld_os_cached, cache bound %s, hierarchy "
+              "bound %s\n",
+              frames, width, height, blocks, bound(cache_bound).c_str(), bound(hierarchy_bound).c_str());
   double agent = 0.0, primary = 0.0, db = 0.0;
   std::size_t samples = 0, batches = 0, relocated = 0, measured = 0;
   for (const frame_row& r : rows) {
@@ -264,7 +269,7 @@ int pareto_walk(int argc, char** argv) {
   std::string csv_path = "walk.csv", shader_name = "simple";
   std::uint32_t width = 320, height = 240, frames = 120, loop = 0, blocks = 26;
   bool long_path = false;
-  std::size_t cache_bound = std::numeric_limits<std::size_t>::max();
+  std::size_t cache_bound = std::numeric_limits<std::size_t>::max(), hierarchy_bound = cache_bound;
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
@@ -276,14 +281,15 @@ int pareto_walk(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--long-path")) long_path = true;
     else if (!std::strcmp(argv[i], "--blocks")) blocks = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--cache-bound")) cache_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
+    else if (!std::strcmp(argv[i], "--hierarchy-bound")) hierarchy_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
     else {
       std::fprintf(stderr, "usage: infolerp_pareto walk --csv FILE [--width W] [--height H] [--frames N] [--loop P] "
-                           "[--shader simple|reference] [--long-path [--blocks B] [--cache-bound C]]\n");
+                           "[--shader simple|reference] [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]\n");
       return 2;
     }
   }
   if (frames < 2 || width == 0 || height == 0 || loop == 1 || (shader_name != "simple" && shader_name != "reference") ||
-      blocks == 0 || cache_bound == 0 || (long_path && loop != 0)) {
+      blocks == 0 || cache_bound == 0 || hierarchy_bound == 0 || (long_path && loop != 0)) {
     std::fprintf(stderr, "walk: need frames >= 2, a non-empty image, --loop 0 or >= 2 (not with --long-path), "
                          "--shader simple|reference, --blocks >= 1, --cache-bound >= 1\n");
     return 2;
@@ -301,7 +307,7 @@ int pareto_walk(int argc, char** argv) {
                                                  : shade_fn{[&](glm::vec3 p, std::uint32_t t) { return lighting.shade(p, t); }};
 
   const char* names[3] = {"nld_os_cached", "nld_os_restart", "rnd_cached"};
-  infolerp::progressive_refiner agents[3] = {make_agent(sc, infolerp::refinement_criterion::nld_os, cache_bound),
+  infolerp::progressive_refiner agents[3] = {make_agent(sc, infolerp::refinement_criterion::nld_os, cache_bound, hierarchy_bound),
                                              make_agent(sc, infolerp::refinement_criterion::nld_os),
                                              make_agent(sc, infolerp::refinement_criterion::rnd)};
   const int methods = long_path ? 1 : 3;
@@ -328,7 +334,7 @@ int pareto_walk(int argc, char** argv) {
                    rows[m][f].later_batch_seconds, rows[m][f].later_batches, rows[m][f].relocated_pixels,
                    rows[m][f].memory_bytes);
   std::fclose(csv);
-  if (long_path) return report_long_path(rows[0], frames, blocks, width, height, cache_bound, csv_path);
+  if (long_path) return report_long_path(rows[0], frames, blocks, width, height, cache_bound, hierarchy_bound, csv_path);
 
   std::printf("walk: %u frames at %ux%u, street -> temple -> street%s, R = 64, 6-pixel floor, %s shader\n", frames, width,
               height, loop ? (", looped every " + std::to_string(loop) + " frames").c_str() : "", shader_name.c_str());

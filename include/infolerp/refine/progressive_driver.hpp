@@ -12,6 +12,11 @@
 // 20 bytes per vertex plus 40 per hierarchy triangle. With max_cached_samples, vertices outside
 // the view are evicted least recently visible first; the current view's are never evicted, and
 // refinement stops (cache_full) once they alone reach the bound.
+// Hierarchy: with max_hierarchy_triangles, a new view that finds more triangles in use prunes
+// (subdivision_mesh::coarsen) subtrees outside the view, least recently in view first, down to
+// bound − bound/8: only subtrees none of whose triangles is in view, shown or awaiting a delta
+// and none of whose created vertices is cached or requested, so nothing the view shows changes.
+// Freed ids are reused by later splits. The current view's triangles are never pruned.
 // Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
 // hands out shading_points, deliver() takes colours for any subset in any order, from any thread
 // or machine (calls on one refiner must not overlap). shade_requests() is the synchronous adaptor.
@@ -93,6 +98,7 @@ struct driver_options {
   std::size_t max_shading_samples = std::numeric_limits<std::size_t>::max();  // stop once this many vertices are shaded
   std::size_t max_batches = std::numeric_limits<std::size_t>::max();          // stop after this many batches
   std::size_t max_cached_samples = std::numeric_limits<std::size_t>::max();  // cache bound (>= 1), see the prologue
+  std::size_t max_hierarchy_triangles = std::numeric_limits<std::size_t>::max();  // hierarchy bound (>= 1), see the prologue
   glm::vec3 background{0.0f};                                              // colour of pixels without a hit or shown triangle
   std::size_t grain = 4096;                                                // executor grain (pixels, vertices)
 };
@@ -186,6 +192,8 @@ class progressive_refiner {
     if (options.grain == 0) return make_error(errc::bad_parameter, no_element, "driver_options.grain must be >= 1");
     if (options.max_cached_samples == 0)
       return make_error(errc::bad_parameter, no_element, "driver_options.max_cached_samples must be >= 1");
+    if (options.max_hierarchy_triangles == 0)
+      return make_error(errc::bad_parameter, no_element, "driver_options.max_hierarchy_triangles must be >= 1");
     progressive_refiner r;
     r.initial_mesh_ = mesh;
     r.mesh_ = std::move(mesh);
@@ -394,6 +402,14 @@ class progressive_refiner {
     return {};
   }
 
+  // Bounds the hierarchy (see the prologue), applied at the next view. Errors: a bound of 0;
+  // then nothing changes.
+  status set_hierarchy_bound(std::size_t max_hierarchy_triangles) {
+    if (max_hierarchy_triangles == 0) return make_error(errc::bad_parameter, no_element, "hierarchy bound must be >= 1");
+    options_.max_hierarchy_triangles = max_hierarchy_triangles;
+    return {};
+  }
+
   // The current image: per pixel the colours of the shown triangle over it interpolated (each
   // channel kept within its corners' range, so inside the range of what was delivered), or the
   // background. Preconditions: image.size() == width·height, a view was set. O(pixels), no
@@ -429,7 +445,7 @@ class progressive_refiner {
              pixel_next_, fresh_, split_, green_first_, lum_tree_, tree_level_, tree_next_, dirty_, dirty_mark_, shown_above_,
              merged_, scratch_, shown_count_, waiters_, waiter_head_, waiter_clock_, touched_, seeds_, stack_, vstate_,
              colour_, luminance_, last_seen_, delivered_epoch_, to_issue_, in_sent_, listed_, changed_, path_, evict_,
-             selected_);
+             selected_, freed_triangles_, freed_vertices_);
   }
   // The frame the criteria see (pixel luminances filled only for NLD_IS).
   [[nodiscard]] refinement_frame frame() const {
@@ -629,19 +645,16 @@ class progressive_refiner {
       select_for_refinement(f, options_.criteria, state_, selected_, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
         nld_os_.select(f, options_.criteria, ids, limit);
       });
-      const auto first_new = static_cast<std::uint32_t>(mesh_.triangle_count());
       if (selected_.empty()) {
         finished_ = true;
         report_.stage2 = figures();
         return b == 0 ? refine_progress::finished : refine_progress::refined;
       }
-      for (std::uint32_t t : selected_) {
-        [[maybe_unused]] const status st = mesh_.split(t);
-        INFOLERP_ASSERT(st.ok());
-      }
+      [[maybe_unused]] const status st = mesh_.split(selected_);  // in order, as split(t) one by one
+      INFOLERP_ASSERT(st.ok());
       ++report_.batches;
       report_.selections += selected_.size();
-      follow_splits(first_new);
+      follow_splits();
       render(exec);
       report_.stage2 = figures();
     }
@@ -754,6 +767,47 @@ class progressive_refiner {
     stamp_in_view(fresh_);
     enforce_cache_bound();
     update_display();
+    prune_hierarchy();
+  }
+
+  // The hierarchy bound (see the prologue): the largest subtrees outside the view (split
+  // triangles out of view whose parent is in view, or roots), least recently in view first
+  // (ties by id), each collapsed with what its split edges tie it to when nothing it holds is
+  // in view, shown, awaiting a delta, cached or requested. O(triangles · log) per call that
+  // prunes, once per bound/8 growth.
+  void prune_hierarchy() {
+    const std::size_t bound = options_.max_hierarchy_triangles;
+    if (mesh_.live_triangle_count() <= bound) return;
+    const std::size_t target = bound - bound / 8;
+    evict_.clear();
+    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t) {
+      const subdivision_triangle& n = mesh_.triangle(t);
+      if (n.child_count == 0 || n.retired || in_view_[t] == clock_) continue;
+      if (n.parent == invalid_id || in_view_[n.parent] == clock_) evict_.push_back(t);
+    }
+    std::sort(evict_.begin(), evict_.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return in_view_[a] != in_view_[b] ? in_view_[a] < in_view_[b] : a < b; });
+    const auto allow_triangle = [&](std::uint32_t t) {
+      return in_view_[t] != clock_ && !in_sent_[t] && !listed_[t] && !shown_.contains(t);
+    };
+    const auto allow_vertex = [&](std::uint32_t v) { return vstate_[v] == unshaded && last_seen_[v] != clock_; };
+    for (std::uint32_t t : evict_) {
+      if (mesh_.live_triangle_count() <= target) break;
+      if (mesh_.triangle(t).child_count == 0) continue;  // collapsed with an earlier one
+      freed_triangles_.clear();
+      freed_vertices_.clear();
+      if (!mesh_.coarsen(t, allow_triangle, allow_vertex, freed_triangles_, freed_vertices_)) continue;
+      for (std::uint32_t x : mesh_.coarsened()) green_first_[x] = invalid_id;
+      for (std::uint32_t x : freed_triangles_) {
+        leaf_pixels_[x] = 0, leaf_head_[x] = invalid_id, green_first_[x] = invalid_id, in_sent_[x] = 0, listed_[x] = 0;
+        in_view_[x] = 0, display_of_[x] = invalid_id, dirty_mark_[x] = 0, shown_count_[x] = 0, decided_[x] = 0;
+        shown_mark_[x] = 0, decision_[x] = display_step{};
+      }
+      for (std::uint32_t v : freed_vertices_) {
+        waiter_head_[v] = invalid_id, waiter_clock_[v] = 0, vstate_[v] = unshaded, colour_[v] = glm::vec3(0.0f);
+        luminance_[v] = 0.0f, last_seen_[v] = 0, delivered_epoch_[v] = 0;
+      }
+    }
   }
 
   // The first children of every 1:2 split (their parent's 1:4 resplit retires both).
@@ -764,11 +818,11 @@ class progressive_refiner {
   }
 
   // The visible leaves a batch's splits took out of the leaf set, found from the triangles it
-  // created (ids from first_new on): a split leaf is the parent of new children, a retired 1:2
-  // child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
-  void find_split_leaves(std::uint32_t first_new) {
+  // created (subdivision_mesh::created): a split leaf is the parent of new children, a retired
+  // 1:2 child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
+  void find_split_leaves() {
     split_.clear();
-    for (std::uint32_t c = first_new; c < mesh_.triangle_count(); ++c) {
+    for (std::uint32_t c : mesh_.created()) {
       const std::uint32_t p = mesh_.triangle(c).parent;
       const subdivision_triangle& n = mesh_.triangle(p);
       if (n.first_child != c) continue;  // one visit per split (a 1:2 split resplit in this batch has another first child)
@@ -788,9 +842,9 @@ class progressive_refiner {
   // pixels, and only the new leaves are walked up for the in-view marks and requests (the
   // in-view set of a view only grows). O(new triangles · log + pixels of the split leaves · level)
   // (the visible set is an id_set: O(1) per leaf that leaves or enters).
-  void follow_splits(std::uint32_t first_new) {
+  void follow_splits() {
     grow();
-    find_split_leaves(first_new);
+    find_split_leaves();
     fresh_.clear();
     begin_display_update();
     for (std::uint32_t t : split_) {
@@ -1145,6 +1199,7 @@ class progressive_refiner {
   std::vector<std::uint8_t> in_sent_, listed_;  // per triangle: shown at the last delta; in changed_
   std::vector<std::uint32_t> changed_;         // triangles whose membership changed since the last delta
   std::vector<std::uint32_t> path_, evict_;
+  std::vector<std::uint32_t> freed_triangles_, freed_vertices_;  // prune_hierarchy()'s, per coarsen
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
   std::size_t samples_ = 0;
