@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <tuple>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -298,6 +299,12 @@ TEST_CASE("driver: errors") {
   auto s = subdivision_mesh::create(m);
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(*s, {.criteria = {.s_req = 2.0f}}).error().code() == errc::bad_parameter);
+  const auto bounded = progressive_refiner::create(*s, {.max_hierarchy_triangles = 0});
+  REQUIRE_FALSE(bounded.ok());
+  CHECK(bounded.error().message().find("max_hierarchy_triangles") != std::string::npos);
+  auto fine = progressive_refiner::create(*s);
+  REQUIRE(fine.ok());
+  CHECK(fine->set_hierarchy_bound(0).code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.batch = 0}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = 1.5f}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = std::numeric_limits<float>::quiet_NaN()}})
