@@ -407,6 +407,7 @@ class progressive_refiner {
   status set_hierarchy_bound(std::size_t max_hierarchy_triangles) {
     if (max_hierarchy_triangles == 0) return make_error(errc::bad_parameter, no_element, "hierarchy bound must be >= 1");
     options_.max_hierarchy_triangles = max_hierarchy_triangles;
+    prune_retry_ = 0;
     return {};
   }
 
@@ -593,6 +594,7 @@ class progressive_refiner {
     clock_ = 0;
     view_requests_ = 0;
     delta_epoch_ = 0;
+    prune_retry_ = 0;
     shown_.reset();
   }
 
@@ -774,10 +776,11 @@ class progressive_refiner {
   // triangles out of view whose parent is in view, or roots), least recently in view first
   // (ties by id), each collapsed with what its split edges tie it to when nothing it holds is
   // in view, shown, awaiting a delta, cached or requested. O(triangles · log) per call that
-  // prunes, once per bound/8 growth.
+  // prunes, once per bound/8 growth: a call that cannot reach bound − bound/8 (what is left is
+  // in view or cached) waits until the hierarchy grew by bound/8 more.
   void prune_hierarchy() {
     const std::size_t bound = options_.max_hierarchy_triangles;
-    if (mesh_.live_triangle_count() <= bound) return;
+    if (mesh_.live_triangle_count() <= bound || mesh_.live_triangle_count() < prune_retry_) return;
     const std::size_t target = bound - bound / 8;
     evict_.clear();
     for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t) {
@@ -808,6 +811,7 @@ class progressive_refiner {
         luminance_[v] = 0.0f, last_seen_[v] = 0, delivered_epoch_[v] = 0;
       }
     }
+    prune_retry_ = mesh_.live_triangle_count() > target ? mesh_.live_triangle_count() + bound / 8 : 0;
   }
 
   // The first children of every 1:2 split (their parent's 1:4 resplit retires both).
@@ -1200,6 +1204,7 @@ class progressive_refiner {
   std::vector<std::uint32_t> changed_;         // triangles whose membership changed since the last delta
   std::vector<std::uint32_t> path_, evict_;
   std::vector<std::uint32_t> freed_triangles_, freed_vertices_;  // prune_hierarchy()'s, per coarsen
+  std::size_t prune_retry_ = 0;  // prune_hierarchy() waits until this many triangles are in use
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
   std::size_t samples_ = 0;

@@ -377,11 +377,14 @@ class subdivision_mesh {
                std::vector<std::uint32_t>& freed_triangles, std::vector<std::uint32_t>& freed_vertices) {
     if (t >= tris_.size() || !collect_component(t, allow_triangle, allow_vertex)) return false;
     created_.clear();
-    for (std::uint32_t d : subtree_)  // every edge inside a collapsed subtree goes (its members' own edges stay)
+    for (std::uint32_t d : subtree_) {  // every edge inside a collapsed subtree goes (its member's own edges stay)
+      std::uint32_t x = d;  // the member d lies in: a subtree's edges lie inside it or on its edges
+      while (tris_[x].parent != invalid_id && mark_[tris_[x].parent] == mark_clock_) x = tris_[x].parent;
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t a = tris_[d].vertices[k], b = tris_[d].vertices[(k + 1) % 3];
-        if (!own_edge(a, b)) edges_.erase(a, b);
+        if (!(has_vertex(x, a) && has_vertex(x, b))) edges_.erase(a, b);
       }
+    }
     for (std::uint32_t x : component_) {  // the members' own edges: no midpoint, the member as a face
       for (int k = 0; k < 3; ++k) {
         auto& e = edges_.get(tris_[x].vertices[k], tris_[x].vertices[(k + 1) % 3]);
@@ -762,6 +765,7 @@ class subdivision_mesh {
     if (++mark_clock_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), mark_clock_ = 1;
     component_.clear();
     subtree_.clear();
+    vertices_.clear();
     stack_.assign(1, t);
     while (!stack_.empty()) {
       std::uint32_t x = stack_.back();
@@ -790,8 +794,15 @@ class subdivision_mesh {
           subtree_.push_back(d);
         }
         if (retired_first_[d] != invalid_id) walk_.push_back(retired_first_[d]), walk_.push_back(retired_first_[d] + 1);
-        if (!m.retired)
-          for (std::uint32_t c = m.first_child; m.child_count && c < m.first_child + m.child_count; ++c) walk_.push_back(c);
+        if (m.retired || m.child_count == 0) continue;
+        // The vertices d's split created (a 1:4 split's centre child, a 1:2 split's middle
+        // corner), checked at once so a refusal costs little.
+        const glm::uvec3 created = tris_[m.first_child + (m.child_count == 4 ? 3 : 0)].vertices;
+        for (int k = m.child_count == 4 ? 0 : 1; k < (m.child_count == 4 ? 3 : 2); ++k) {
+          if (!allow_vertex(created[k])) return false;
+          vertices_.push_back(created[k]);
+        }
+        for (std::uint32_t c = m.first_child; c < m.first_child + m.child_count; ++c) walk_.push_back(c);
       }
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t a = n.vertices[k], b = n.vertices[(k + 1) % 3];
@@ -801,10 +812,8 @@ class subdivision_mesh {
         if (y != invalid_id) stack_.push_back(y);
       }
     }
-    // The vertices the collapsed subtrees created: theirs, less the members' corners.
-    vertices_.clear();
-    for (std::uint32_t d : subtree_)
-      for (int k = 0; k < 3; ++k) vertices_.push_back(tris_[d].vertices[k]);
+    // The vertices the collapsed subtrees created (a midpoint shared by two splits once), less
+    // any member's corner.
     std::sort(vertices_.begin(), vertices_.end());
     vertices_.erase(std::unique(vertices_.begin(), vertices_.end()), vertices_.end());
     corners_.clear();
@@ -814,8 +823,6 @@ class subdivision_mesh {
     vertices_.erase(std::remove_if(vertices_.begin(), vertices_.end(),
                                    [&](std::uint32_t v) { return std::binary_search(corners_.begin(), corners_.end(), v); }),
                     vertices_.end());
-    for (std::uint32_t v : vertices_)
-      if (!allow_vertex(v)) return false;
     return true;
   }
   // The triangle across edge (A, B) of x, found along the segment (a, b) of it: y, or invalid_id
@@ -837,14 +844,6 @@ class subdivision_mesh {
       }
     }
     return true;
-  }
-  // Whether (a, b) is an edge of a member (coarsen() keeps those entries).
-  [[nodiscard]] bool own_edge(std::uint32_t a, std::uint32_t b) const {
-    if (!std::binary_search(corners_.begin(), corners_.end(), a) || !std::binary_search(corners_.begin(), corners_.end(), b))
-      return false;
-    for (std::uint32_t x : component_)
-      if (has_vertex(x, a) && has_vertex(x, b)) return true;
-    return false;
   }
   [[nodiscard]] bool has_vertex(std::uint32_t t, std::uint32_t v) const noexcept {
     const glm::uvec3 w = tris_[t].vertices;
