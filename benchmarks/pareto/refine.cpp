@@ -184,21 +184,34 @@ int pareto_refine(int argc, char** argv) {
     os_fine.push_back({rr.report.stage2.shading_samples, rr.psnr2});
     if (!rr.report.budget_reached) break;
   }
-  // The headline, the accepted criterion: the fewest samples with which NLD_OS comes within
-  // 0.1 dB of RND's final image, as a fraction of RND's samples.
-  {
+  // NLD_IS the same way (its walk to pixel size costs more per batch: the run is longer).
+  std::vector<std::pair<std::size_t, double>> is_fine;
+  for (std::size_t budget = 25;; budget += 25) {
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_is, budget, s_req, exec);
+    is_fine.push_back({rr.report.stage2.shading_samples, rr.psnr2});
+    if (!rr.report.budget_reached) break;
+  }
+  // The headline, the accepted criterion: the fewest samples with which NLD_OS (goal <= 25%)
+  // and NLD_IS (goal <= 35%) come within 0.1 dB of RND's final image, as a fraction of RND's.
+  const auto within = [&](const char* name, const std::vector<std::pair<std::size_t, double>>& fine, int goal) {
     const double target = final_runs[2].psnr2 - 0.1;
     const std::size_t rnd_total = final_runs[2].report.stage2.shading_samples;
-    const auto reach = std::find_if(os_fine.begin(), os_fine.end(), [&](const auto& p) { return p.second >= target; });
-    if (reach == os_fine.end())
-      std::printf("accepted criterion: NLD_OS does not come within 0.1 dB of RND's final %.2f dB (%zu samples)\n",
+    const auto reach = std::find_if(fine.begin(), fine.end(), [&](const auto& p) { return p.second >= target; });
+    if (reach == fine.end())
+      std::printf("accepted criterion: %s does not come within 0.1 dB of RND's final %.2f dB (%zu samples)\n", name,
                   final_runs[2].psnr2, rnd_total);
     else
-      std::printf("accepted criterion: NLD_OS reaches RND's final image within 0.1 dB (%.2f against %.2f dB) with %zu "
-                  "samples = %.1f%% of RND's %zu\n",
-                  reach->second, final_runs[2].psnr2, reach->first, 100.0 * double(reach->first) / double(rnd_total),
-                  rnd_total);
-  }
+      std::printf("accepted criterion: %s reaches RND's final image within 0.1 dB (%.2f against %.2f dB) with %zu "
+                  "samples = %.1f%% of RND's %zu (goal <= %d%%)\n",
+                  name, reach->second, final_runs[2].psnr2, reach->first, 100.0 * double(reach->first) / double(rnd_total),
+                  rnd_total, goal);
+  };
+  within("NLD_OS", os_fine, 25);
+  within("NLD_IS", is_fine, 35);
+  // Regression figure: the agent's wall time to each criterion's final image (stage 2's
+  // seconds, Lambert shading included), all from this run.
+  std::printf("time to the final image: NLD_OS %.3f s, NLD_IS %.3f s, RND %.3f s\n", final_runs[0].report.stage2.seconds,
+              final_runs[1].report.stage2.seconds, final_runs[2].report.stage2.seconds);
 
   // Table 1 of the paper, for this scene.
   std::printf("scene: %zu triangles, %ux%u pixels\n", sc.mesh.triangles.size(), width, height);

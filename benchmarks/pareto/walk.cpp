@@ -1,9 +1,14 @@
 // infolerp_pareto walk --csv FILE [--width W --height H --frames N --loop P --shader simple|reference]
+//                      [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]
 //
 // The walkthrough of Oliveira, Santos, Proença (§2, §4.1) on the procedural walkthrough scene:
 // a path of N frames from the street view into the temple view and back the same way
 // (support::walkthrough_path); with --loop P the path is P frames long and walked again and
-// again for N frames. Three methods, every one in this run:
+// again for N frames. With --long-path the scene is a street of B repeated blocks
+// (support::make_long_street_scene, default 26) walked from the first block to the last in N
+// frames, never coming back, with nld_os_cached alone (its cache bounded to C samples and its
+// hierarchy to T triangles if given: progressive_refiner prunes what is out of view)
+// and the PSNR taken every 10th frame. Three methods, every one in this run:
 //   nld_os_cached   one agent; set_view() per frame, hierarchy and shading cache kept;
 //   nld_os_restart  start() per frame (hierarchy and cache thrown away);
 //   rnd_cached      as nld_os_cached with the RND criterion.
@@ -16,10 +21,12 @@
 // blocks of 256 rays) as primary_seconds. Serial executor, so all times share one core.
 //
 // CSV: method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches,
-// later_batch_seconds,later_batches (samples: newly shaded in the frame; psnr_db: the frame's
+// later_batch_seconds,later_batches,relocated_pixels,memory_bytes (samples: newly shaded in the frame; psnr_db: the frame's
 // final image against the per-pixel reference of that frame; batches: batches of R run in the
 // frame; later_*: the frame's batches after its first, which alone builds the view's luminance
-// image, and the agent time of their refine and of their requests' take, deliver and delta).
+// image, and the agent time of their refine and of their requests' take, deliver and delta;
+// relocated_pixels: pixels whose leaf the frame's batches changed, counted outside the timed
+// calls; memory_bytes: progressive_refiner::memory_bytes() after the frame).
 // Beside it: FILE.png (PSNR, new samples, agent and primary-ray time per frame, gnuplot) and
 // FILE.gp (its script). Printed: the goals (cached samples against restart's, per-frame PSNR
 // gap, agent time against its primary rays, agent time per batch without them, history with
@@ -33,6 +40,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -97,15 +105,18 @@ class reference_lighting {
 std::vector<glm::vec3> reference_image(const scene& sc, const infolerp::pinhole_camera& cam, const shade_fn& shade) {
   std::vector<glm::vec3> img(std::size_t(cam.width) * cam.height, glm::vec3(0.0f));
   infolerp::support::enable_flush_to_zero();
+  const infolerp::pinhole_frame frame = cam.frame();
   for (std::size_t p = 0; p < img.size(); ++p) {
-    const infolerp::ray r = cam.primary_ray(static_cast<std::uint32_t>(p % cam.width), static_cast<std::uint32_t>(p / cam.width));
+    const infolerp::ray r = frame.primary_ray(static_cast<std::uint32_t>(p % cam.width), static_cast<std::uint32_t>(p / cam.width));
     const infolerp::hit h = sc.intersect(r);
     if (h.valid()) img[p] = shade(r.origin + h.distance * r.direction, h.triangle);
   }
   return img;
 }
 
-infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_criterion c) {
+infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_criterion c,
+                                        std::size_t cache_bound = std::numeric_limits<std::size_t>::max(),
+                                        std::size_t hierarchy_bound = std::numeric_limits<std::size_t>::max()) {
   auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   infolerp::driver_options o;
   o.criteria.criterion = c;
@@ -113,6 +124,8 @@ infolerp::progressive_refiner make_agent(const scene& sc, infolerp::refinement_c
   o.criteria.s_req = 0.05f;
   o.criteria.min_pixels = 6.0f;
   o.criteria.always_refine_fraction = 0.02f;
+  o.max_cached_samples = cache_bound;
+  o.max_hierarchy_triangles = hierarchy_bound;
   auto r = sub.ok() ? infolerp::progressive_refiner::create(std::move(*sub), o)
                     : infolerp::result<infolerp::progressive_refiner>(sub.error());
   if (!r) {
@@ -130,6 +143,7 @@ struct frame_row {
   std::size_t later_batches = 0;
   double later_batch_seconds = 0.0;
   std::size_t relocated_pixels = 0;  // pixels whose leaf a batch changed (counted untimed, on request)
+  std::size_t memory_bytes = 0;      // the agent's, after the frame
 };
 
 // The frame's primary rays traced alone, as the agent traces them (made and traced in blocks of
@@ -140,10 +154,11 @@ double primary_rays_seconds(const scene& sc, const infolerp::pinhole_camera& cam
   const std::size_t n = std::size_t(cam.width) * cam.height;
   std::vector<infolerp::hit> hits(n);
   std::vector<infolerp::ray> rays(block);
+  const infolerp::pinhole_frame frame = cam.frame();  // as the agent does: the basis once, not per ray
   for (std::size_t begin = 0; begin < n; begin += block) {
     const std::size_t m = std::min(block, n - begin);
     for (std::size_t i = 0; i < m; ++i)
-      rays[i] = cam.primary_ray(static_cast<std::uint32_t>((begin + i) % cam.width),
+      rays[i] = frame.primary_ray(static_cast<std::uint32_t>((begin + i) % cam.width),
                                 static_cast<std::uint32_t>((begin + i) / cam.width));
     infolerp::trace_intersect(*sc.tracer, std::span<const infolerp::ray>(rays.data(), m),
                               std::span<infolerp::hit>(hits.data() + begin, m));
@@ -206,18 +221,55 @@ frame_row walk_frame(infolerp::progressive_refiner& agent, const scene& sc, cons
   }
   row.samples = agent.samples_delivered() - before;
   row.batches = agent.report().batches;
+  row.memory_bytes = agent.memory_bytes();
+  row.psnr_db = std::numeric_limits<double>::quiet_NaN();
+  if (reference.empty()) return row;
   std::vector<glm::vec3> img(reference.size());
   agent.reconstruct(img);
   row.psnr_db = linear_psnr(img, reference);
   return row;
 }
 
+// --long-path's report: memory and agent time along a walk that never comes back.
+int report_long_path(const std::vector<frame_row>& rows, std::uint32_t frames, std::uint32_t blocks, std::uint32_t width,
+                     std::uint32_t height, std::size_t cache_bound, std::size_t hierarchy_bound, const std::string& csv_path) {
+  const auto bound = [](std::size_t b) { return b == std::numeric_limits<std::size_t>::max() ? std::string("none") : std::to_string(b); };
+  std::printf("walk --long-path: %u frames at %ux%u down a street of %u blocks, nld_os_cached, cache bound %s, hierarchy "
+              "bound %s\n",
+              frames, width, height, blocks, bound(cache_bound).c_str(), bound(hierarchy_bound).c_str());
+  double agent = 0.0, primary = 0.0, db = 0.0;
+  std::size_t samples = 0, batches = 0, relocated = 0, measured = 0;
+  for (const frame_row& r : rows) {
+    agent += r.agent, primary += r.primary, samples += r.samples, batches += r.batches, relocated += r.relocated_pixels;
+    if (!std::isnan(r.psnr_db)) db += r.psnr_db, ++measured;
+  }
+  std::printf("samples %zu, batches %zu, mean PSNR %.2f dB over %zu measured frames; agent %.3f s, primary rays alone "
+              "%.3f s: agent / primary %.3f; pixels re-located per batch %.1f\n",
+              samples, batches, measured ? db / double(measured) : 0.0, measured, agent, primary, agent / primary,
+              batches ? double(relocated) / double(batches) : 0.0);
+  for (std::uint32_t f : {0u, 119u, 499u, 999u, 1499u, frames - 1})
+    if (f < frames) std::printf("memory_bytes after frame %u: %zu\n", f + 1, rows[f].memory_bytes);
+  if (frames >= 500)
+    std::printf("memory at frame %u / at frame 500: %.3f (goal <= 1.25 at frame 2000)\n", frames,
+                double(rows[frames - 1].memory_bytes) / double(rows[499].memory_bytes));
+  if (frames >= 320) {
+    double first = 0.0, last = 0.0;
+    for (std::uint32_t f = 120; f < 220; ++f) first += rows[f].agent;
+    for (std::uint32_t f = frames - 100; f < frames; ++f) last += rows[f].agent;
+    std::printf("history: agent over the last 100 frames %.4f s, over frames 120-219 %.4f s: ratio %.3f (goal <= 1.2)\n",
+                last, first, last / first);
+  }
+  std::printf("wrote %s\n", csv_path.c_str());
+  return 0;
+}
 
 }  // namespace
 
 int pareto_walk(int argc, char** argv) {
   std::string csv_path = "walk.csv", shader_name = "simple";
-  std::uint32_t width = 320, height = 240, frames = 120, loop = 0;
+  std::uint32_t width = 320, height = 240, frames = 120, loop = 0, blocks = 26;
+  bool long_path = false;
+  std::size_t cache_bound = std::numeric_limits<std::size_t>::max(), hierarchy_bound = cache_bound;
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
@@ -226,19 +278,25 @@ int pareto_walk(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--frames")) frames = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--loop")) loop = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--shader")) shader_name = next();
+    else if (!std::strcmp(argv[i], "--long-path")) long_path = true;
+    else if (!std::strcmp(argv[i], "--blocks")) blocks = static_cast<std::uint32_t>(std::atoi(next().c_str()));
+    else if (!std::strcmp(argv[i], "--cache-bound")) cache_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
+    else if (!std::strcmp(argv[i], "--hierarchy-bound")) hierarchy_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
     else {
       std::fprintf(stderr, "usage: infolerp_pareto walk --csv FILE [--width W] [--height H] [--frames N] [--loop P] "
-                           "[--shader simple|reference]\n");
+                           "[--shader simple|reference] [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]\n");
       return 2;
     }
   }
-  if (frames < 2 || width == 0 || height == 0 || loop == 1 || (shader_name != "simple" && shader_name != "reference")) {
-    std::fprintf(stderr, "walk: need frames >= 2, a non-empty image, --loop 0 or >= 2, --shader simple|reference\n");
+  if (frames < 2 || width == 0 || height == 0 || loop == 1 || (shader_name != "simple" && shader_name != "reference") ||
+      blocks == 0 || cache_bound == 0 || hierarchy_bound == 0 || (long_path && loop != 0)) {
+    std::fprintf(stderr, "walk: need frames >= 2, a non-empty image, --loop 0 or >= 2 (not with --long-path), "
+                         "--shader simple|reference, --blocks >= 1, --cache-bound >= 1\n");
     return 2;
   }
   const std::uint32_t period = loop == 0 ? frames : loop;
   const std::string stem = csv_path.substr(0, csv_path.rfind('.'));
-  auto built = infolerp::support::make_walkthrough_scene();
+  auto built = long_path ? infolerp::support::make_long_street_scene(blocks) : infolerp::support::make_walkthrough_scene();
   if (!built) {
     std::fprintf(stderr, "%s\n", built.error().message().c_str());
     return 1;
@@ -249,15 +307,17 @@ int pareto_walk(int argc, char** argv) {
                                                  : shade_fn{[&](glm::vec3 p, std::uint32_t t) { return lighting.shade(p, t); }};
 
   const char* names[3] = {"nld_os_cached", "nld_os_restart", "rnd_cached"};
-  infolerp::progressive_refiner agents[3] = {make_agent(sc, infolerp::refinement_criterion::nld_os),
+  infolerp::progressive_refiner agents[3] = {make_agent(sc, infolerp::refinement_criterion::nld_os, cache_bound, hierarchy_bound),
                                              make_agent(sc, infolerp::refinement_criterion::nld_os),
                                              make_agent(sc, infolerp::refinement_criterion::rnd)};
+  const int methods = long_path ? 1 : 3;
   std::vector<frame_row> rows[3];
   for (std::uint32_t f = 0; f < frames; ++f) {
-    const infolerp::pinhole_camera cam = infolerp::support::walkthrough_path(f % period, period, width, height);
-    const std::vector<glm::vec3> reference = reference_image(sc, cam, shade);
-    for (int m = 0; m < 3; ++m)  // interleaved per frame
-      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade, m == 0));
+    const infolerp::pinhole_camera cam = long_path ? infolerp::support::long_street_path(f, frames, blocks, width, height)
+                                                   : infolerp::support::walkthrough_path(f % period, period, width, height);
+    const std::vector<glm::vec3> reference = !long_path || f % 10 == 0 ? reference_image(sc, cam, shade) : std::vector<glm::vec3>{};
+    for (int m = 0; m < methods; ++m)  // interleaved per frame
+      rows[m].push_back(walk_frame(agents[m], sc, cam, m == 1, reference, shade, true));
   }
 
   std::FILE* csv = std::fopen(csv_path.c_str(), "w");
@@ -266,13 +326,15 @@ int pareto_walk(int argc, char** argv) {
     return 1;
   }
   std::fprintf(csv, "method,frame,samples,psnr_db,agent_seconds,shader_seconds,primary_seconds,batches,"
-                   "later_batch_seconds,later_batches\n");
-  for (int m = 0; m < 3; ++m)
+                   "later_batch_seconds,later_batches,relocated_pixels,memory_bytes\n");
+  for (int m = 0; m < methods; ++m)
     for (std::uint32_t f = 0; f < frames; ++f)
-      std::fprintf(csv, "%s,%u,%zu,%.3f,%.6f,%.6f,%.6f,%zu,%.6f,%zu\n", names[m], f, rows[m][f].samples, rows[m][f].psnr_db,
-                   rows[m][f].agent, rows[m][f].shader, rows[m][f].primary, rows[m][f].batches,
-                   rows[m][f].later_batch_seconds, rows[m][f].later_batches);
+      std::fprintf(csv, "%s,%u,%zu,%.3f,%.6f,%.6f,%.6f,%zu,%.6f,%zu,%zu,%zu\n", names[m], f, rows[m][f].samples,
+                   rows[m][f].psnr_db, rows[m][f].agent, rows[m][f].shader, rows[m][f].primary, rows[m][f].batches,
+                   rows[m][f].later_batch_seconds, rows[m][f].later_batches, rows[m][f].relocated_pixels,
+                   rows[m][f].memory_bytes);
   std::fclose(csv);
+  if (long_path) return report_long_path(rows[0], frames, blocks, width, height, cache_bound, hierarchy_bound, csv_path);
 
   std::printf("walk: %u frames at %ux%u, street -> temple -> street%s, R = 64, 6-pixel floor, %s shader\n", frames, width,
               height, loop ? (", looped every " + std::to_string(loop) + " frames").c_str() : "", shader_name.c_str());

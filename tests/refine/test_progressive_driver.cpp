@@ -8,8 +8,12 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <tuple>
 #include <vector>
 #include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat4x4.hpp>
 #include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/brute_force_tracer.hpp"
@@ -59,6 +63,21 @@ progressive_refiner make_refiner(const indexed_mesh& m, driver_options o, subdiv
   auto r = progressive_refiner::create(std::move(*s), o);
   REQUIRE(r.ok());
   return std::move(*r);
+}
+
+// Triangle (a, b, c)'s area in pixels under the camera, from glm's own view and projection
+// matrices (independent of pinhole_frame): OpenGL clip space, NDC to pixels with y down.
+double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) {
+  const glm::dmat4 vp = glm::perspective(glm::radians(double(c.vertical_fov_degrees)), double(c.width) / double(c.height), 1e-3, 1e3) *
+                        glm::lookAt(glm::dvec3(c.eye), glm::dvec3(c.target), glm::dvec3(c.up));
+  glm::dvec2 q[3];
+  const glm::vec3 p[3] = {a, b, d};
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec4 h = vp * glm::dvec4(glm::dvec3(p[i]), 1.0);
+    if (!(h.w > 0.0)) return std::numeric_limits<double>::infinity();
+    q[i] = {(h.x / h.w + 1.0) * 0.5 * c.width, (1.0 - h.y / h.w) * 0.5 * c.height};
+  }
+  return 0.5 * std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
 }
 
 std::vector<glm::vec3> image_of(const progressive_refiner& r, const pinhole_camera& cam) {
@@ -153,13 +172,14 @@ TEST_CASE("driver: NLD_OS finds the shadow that misses every vertex, and stops b
   std::size_t shaded = 0;
   for (int c : calls) shaded += std::size_t(c);
   CHECK(shaded == rep->stage2.shading_samples);
-  // Termination rule, checked from outside: no visible leaf qualifies any more.
+  // Termination rule, checked from outside: no visible leaf qualifies any more (projected area
+  // from glm's matrices).
   const auto f = r.frame();
   for (std::uint32_t t : r.visible_leaves()) {
     const double px = f.leaf_pixels[t];
     CHECK(px <= 0.02 * cam.width * cam.height);
-    if (px >= 6.0) {
-      const glm::uvec3 v = r.mesh().triangle(t).vertices;
+    const glm::uvec3 v = r.mesh().triangle(t).vertices;
+    if (oracle_area(cam, r.mesh().position(v.x), r.mesh().position(v.y), r.mesh().position(v.z)) >= 6.0) {
       CHECK(nld(f.vertex_luminance[v.x], f.vertex_luminance[v.y], f.vertex_luminance[v.z], f.l_max) <= 0.05f);
     }
   }
@@ -279,6 +299,12 @@ TEST_CASE("driver: errors") {
   auto s = subdivision_mesh::create(m);
   REQUIRE(s.ok());
   CHECK(progressive_refiner::create(*s, {.criteria = {.s_req = 2.0f}}).error().code() == errc::bad_parameter);
+  const auto bounded = progressive_refiner::create(*s, {.max_hierarchy_triangles = 0});
+  REQUIRE_FALSE(bounded.ok());
+  CHECK(bounded.error().message().find("max_hierarchy_triangles") != std::string::npos);
+  auto fine = progressive_refiner::create(*s);
+  REQUIRE(fine.ok());
+  CHECK(fine->set_hierarchy_bound(0).code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.batch = 0}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = 1.5f}}).error().code() == errc::bad_parameter);
   CHECK(progressive_refiner::create(*s, {.criteria = {.random_share = std::numeric_limits<float>::quiet_NaN()}})
@@ -392,4 +418,118 @@ TEST_CASE("criteria: NLD_OS kept between batches selects what the full scan sele
   }
   CHECK(batches >= 10);  // the comparison ran over many batches, not one
   CHECK(selected >= 60);
+}
+
+namespace {
+
+// NLD_IS by brute force: every quadrant of the image quadtree down to one pixel in a plain list,
+// the next one taken by a linear scan for the largest S (ties: smaller y0, then x0), the
+// triangle under its centre selected when S > S_req, its area (oracle_area) reaches min_pixels
+// and it is not selected already. Up to `batch` ids.
+std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const criteria_options& o, const pinhole_camera& cam) {
+  struct quad {
+    float s;
+    std::uint32_t x0, y0, x1, y1;
+  };
+  const auto L = [&](std::uint32_t x, std::uint32_t y) { return f.pixel_luminance[std::size_t(y) * f.width + x]; };
+  std::vector<quad> open;
+  const auto split = [&](const quad& q) {
+    const std::uint32_t xm = q.x0 + (q.x1 - q.x0 + 1) / 2, ym = q.y0 + (q.y1 - q.y0 + 1) / 2;
+    const std::uint32_t xs[3] = {q.x0, xm, q.x1}, ys[3] = {q.y0, ym, q.y1};
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        if (xs[i] < xs[i + 1] && ys[j] < ys[j + 1]) {
+          const std::uint32_t a = xs[i], b = xs[i + 1] - 1, c = ys[j], d = ys[j + 1] - 1;
+          // S of the four corner pixels (nld.hpp, tested against the pairwise definition there).
+          open.push_back({nld(L(a, c), L(b, c), L(a, d), L(b, d), f.l_max), xs[i], ys[j], xs[i + 1], ys[j + 1]});
+        }
+  };
+  split({0.0f, 0, 0, f.width, f.height});
+  std::vector<std::uint32_t> out;
+  while (!open.empty() && out.size() < o.batch) {
+    auto best = open.begin();
+    for (auto it = open.begin(); it != open.end(); ++it)
+      if (std::tie(best->s, it->y0, it->x0) < std::tie(it->s, best->y0, best->x0)) best = it;
+    const quad q = *best;
+    open.erase(best);
+    const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
+    if (q.s > o.s_req && leaf != invalid_id && std::find(out.begin(), out.end(), leaf) == out.end()) {
+      const glm::uvec3 v = f.mesh->triangle(leaf).vertices;
+      if (oracle_area(cam, f.mesh->position(v.x), f.mesh->position(v.y), f.mesh->position(v.z)) >= double(o.min_pixels))
+        out.push_back(leaf);
+    }
+    if (q.x1 - q.x0 > 1 || q.y1 - q.y0 > 1) split(q);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("criteria: NLD_IS recursion equals a brute-force walk of every quadrant on a small view") {
+  // A 23x17 view (odd sizes: quadrants of unequal halves) of a floor of 3x3 cells with the shadow
+  // edge, refined a few NLD_OS batches so leaves of several levels and sizes are under the pixels.
+  const auto m = support::make_plane(3, 3, 2.0f);
+  const pinhole_camera cam{.eye = {0.3f, -0.9f, 1.6f}, .target = {0, 0, 0}, .up = {0, 1, 0}, .vertical_fov_degrees = 60.0f,
+                           .width = 23, .height = 17};
+  auto shade = [](const shading_point& sp) { return shadowed(sp.position) * (1.0f + 0.3f * sp.position.y); };
+  auto r = make_refiner(m, {.criteria = {.criterion = refinement_criterion::nld_os, .s_req = 0.01f, .min_pixels = 2.0f, .batch = 3}});
+  REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+  for (int b = 0; b < 4; ++b) r.refine(shade, refine_budget{.batches = 1});
+  r.refine(refine_budget{.batches = 1});  // one more batch, its requests left outstanding: the luminance image is the one it read
+  const refinement_frame f = r.frame();
+  REQUIRE(f.pixel_luminance.size() == 23u * 17u);
+  REQUIRE(f.projection != nullptr);
+  std::size_t nonempty = 0, exhaustive = 0;
+  for (float s_req : {0.0f, 0.02f, 0.1f, 0.3f})
+    for (float min_pixels : {0.0f, 1.0f, 6.0f, 40.0f})
+      for (std::uint32_t batch : {1u, 4u, 1000u}) {
+        const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = s_req, .min_pixels = min_pixels, .batch = batch};
+        std::vector<std::uint32_t> got{7u};  // what the caller's vector held stays
+        select_nld_is(f, o, got);
+        REQUIRE(got.front() == 7u);
+        got.erase(got.begin());
+        const std::vector<std::uint32_t> want = nld_is_brute_force(f, o, cam);
+        INFO("s_req " << s_req << ", min_pixels " << min_pixels << ", batch " << batch);
+        CHECK(got == want);
+        nonempty += !want.empty();
+        exhaustive += batch == 1000u && want.size() > 4;  // fewer than R: the walk went to pixel size
+      }
+  CHECK(nonempty >= 20);  // the comparison selected something in most settings
+  CHECK(exhaustive >= 2);
+}
+
+TEST_CASE("driver: NLD_IS at s_req 0 and min_pixels 1 ends by itself, colours inside what was delivered") {
+  // The numerical stress setting: any luminance difference qualifies and a 1-pixel triangle may
+  // split. Bounded by projected area, NLD_IS stops near pixel size instead of sending one pixel's
+  // triangle down until its float corners nearly coincide; every pixel stays within [0, 1].
+  const indexed_mesh m = support::make_plane(2, 2, 2.0f);
+  const pinhole_camera cam{.eye = {0, 0, 1.8f}, .target = {0, 0, 0}, .up = {0, 1, 0}, .vertical_fov_degrees = 60.0f,
+                           .width = 32, .height = 32};
+  auto shade = [](const shading_point& sp) { return glm::vec3(sp.position.x > 0.1f ? 1.0f : 0.0f); };
+  for (auto criterion : {refinement_criterion::nld_is, refinement_criterion::nld_os, refinement_criterion::rnd}) {
+    INFO(to_string(criterion));
+    auto r = make_refiner(m, {.criteria = {.criterion = criterion, .s_req = 0.0f, .min_pixels = 1.0f, .always_refine_fraction = 1.0f},
+                              .max_batches = 400});
+    REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+    std::size_t batches = 0;
+    while (r.refine_batch(shade)) {
+      ++batches;
+      if (criterion != refinement_criterion::nld_is) continue;
+      for (std::uint32_t t : r.last_selection()) {  // what the stress run selected: every one at least a pixel
+        const glm::uvec3 v = r.mesh().triangle(t).vertices;
+        CHECK(oracle_area(cam, r.mesh().position(v.x), r.mesh().position(v.y), r.mesh().position(v.z)) >= 1.0 - 1e-9);
+      }
+    }
+    CHECK(batches > 0);
+    if (criterion == refinement_criterion::nld_is) CHECK_FALSE(r.report().budget_reached);  // ended by its own rule
+    std::uint32_t deepest = 0;
+    for (std::uint32_t t : r.visible_leaves()) deepest = std::max<std::uint32_t>(deepest, r.mesh().triangle(t).level);
+    if (criterion == refinement_criterion::nld_is) CHECK(deepest <= 8);  // a 1-pixel triangle of this view is level 6-7
+    std::vector<glm::vec3> img(32 * 32);
+    r.reconstruct(img);
+    for (const glm::vec3& c : img) {
+      CHECK(c.x >= 0.0f);
+      CHECK(c.x <= 1.0f);
+    }
+  }
 }

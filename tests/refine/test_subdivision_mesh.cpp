@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -74,8 +75,15 @@ void check_invariants(const subdivision_mesh& s, const indexed_mesh& input) {
   // Hierarchy: links, levels, originals, children made of parent corners and edge midpoints,
   // children's areas summing to the parent's.
   std::size_t leaves = 0;
+  std::set<std::uint32_t> used_vertices;  // vertices of triangles in use (coarsen() frees slots and vertices)
   for (std::uint32_t t = 0; t < tris.size(); ++t) {
     const auto& n = tris[t];
+    if (n.retired == 3) {  // a slot coarsen() freed
+      VERIFY(t >= n_orig);
+      VERIFY(n.child_count == 0);
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) used_vertices.insert(n.vertices[k]);
     if (n.is_leaf()) ++leaves;
     if (t < n_orig) {
       VERIFY(n.parent == invalid_id);
@@ -83,7 +91,8 @@ void check_invariants(const subdivision_mesh& s, const indexed_mesh& input) {
       VERIFY(n.original == t);
       VERIFY(n.retired == 0);
     } else {
-      VERIFY(n.parent < t);
+      VERIFY(n.parent < tris.size());  // not always below t: coarsen() frees slots that later splits reuse
+      VERIFY(tris[n.parent].retired != 3);
       const auto& p = tris[n.parent];
       VERIFY(n.level == p.level + 1);
       VERIFY(n.original == p.original);
@@ -120,7 +129,7 @@ void check_invariants(const subdivision_mesh& s, const indexed_mesh& input) {
   // Area conservation per original triangle; orientation and shape of every leaf.
   std::vector<double> leaf_area(n_orig, 0.0), leaf_perimeter(n_orig, 0.0);
   for (const auto& n : tris) {
-    if (!n.is_leaf()) continue;
+    if (!n.is_leaf()) continue;  // free slots are not leaves
     const glm::dvec3 a = P(n.vertices.x), b = P(n.vertices.y), c = P(n.vertices.z);
     leaf_area[n.original] += area(a, b, c);
     leaf_perimeter[n.original] += perimeter(a, b, c);
@@ -140,7 +149,7 @@ void check_invariants(const subdivision_mesh& s, const indexed_mesh& input) {
 
   // No duplicate vertices: a new vertex never sits where another vertex already is.
   std::map<std::tuple<float, float, float>, std::uint32_t> where;
-  for (std::uint32_t v = 0; v < s.vertex_count(); ++v) {
+  for (std::uint32_t v : used_vertices) {
     const glm::vec3 p = s.position(v);
     const auto [it, fresh] = where.insert({{p.x, p.y, p.z}, v});
     if (!fresh) VERIFY(v < input.positions.size());  // only the input may repeat positions
@@ -509,4 +518,83 @@ TEST_CASE("subdivision: tessellation leaves a mesh behind the eye or beside the 
     CHECK(s->tessellate(infolerp::screen_fraction_test{.view_projection = projection * view, .max_fraction = 1e-6f}) == 0);
     CHECK(s->triangle_count() == plane.triangles.size());
   }
+}
+
+namespace {
+// Collapses every split triangle allow() admits, deepest first, until a round collapses nothing.
+std::size_t coarsen_all(subdivision_mesh& s, const std::function<bool(std::uint32_t)>& allow,
+                        std::vector<std::uint32_t>& freed_t, std::vector<std::uint32_t>& freed_v) {
+  std::size_t collapsed = 0;
+  for (bool progress = true; progress;) {
+    progress = false;
+    for (std::uint32_t t = 0; t < s.triangle_count(); ++t)
+      if (s.triangle(t).child_count > 0 && s.coarsen(t, allow, [](std::uint32_t) { return true; }, freed_t, freed_v))
+        progress = true, ++collapsed;
+  }
+  return collapsed;
+}
+}  // namespace
+
+TEST_CASE("subdivision: coarsen undoes splits, keeps the mesh conforming, and splits reuse what it freed") {
+  const indexed_mesh input = infolerp::support::make_plane(6, 6, 2.0f);
+  auto s = subdivision_mesh::create(input, {.propagation_depth = 2});
+  REQUIRE(s.ok());
+  random_selections(*s, input, 600, 5, 100);
+  const std::size_t storage = s->triangle_count(), vertices = s->vertex_count();
+  std::vector<std::uint32_t> freed_t, freed_v;
+
+  // Only the hierarchies of the left half's originals may go: whatever is tied to the right
+  // half through a split edge stays, and the mesh stays conforming.
+  const auto left = [&](std::uint32_t t) { return s->position(s->triangle(s->triangle(t).original).vertices.x).x < 0.0f; };
+  const std::size_t some = coarsen_all(*s, left, freed_t, freed_v);
+  CHECK(some > 0);
+  check_invariants(*s, input);
+  CHECK(s->live_triangle_count() == storage - freed_t.size());
+  for (std::uint32_t t : freed_t) CHECK_FALSE(s->is_leaf(t));
+  std::set<std::uint32_t> distinct_t(freed_t.begin(), freed_t.end()), distinct_v(freed_v.begin(), freed_v.end());
+  CHECK(distinct_t.size() == freed_t.size());  // each slot freed once
+  CHECK(distinct_v.size() == freed_v.size());
+  for (std::uint32_t v : freed_v) CHECK(v >= input.positions.size());  // input vertices are never freed
+
+  // Everything: back to the input, leaf for leaf.
+  coarsen_all(*s, [](std::uint32_t) { return true; }, freed_t, freed_v);
+  check_invariants(*s, input);
+  CHECK(s->leaf_count() == input.triangles.size());
+  CHECK(s->live_triangle_count() == input.triangles.size());
+  for (std::uint32_t t = 0; t < input.triangles.size(); ++t) {
+    CHECK(s->is_leaf(t));
+    CHECK(s->triangle(t).vertices == input.triangles[t]);
+  }
+  for (std::uint32_t t = 0; t < input.triangles.size(); ++t)  // no midpoint is left on an input edge
+    for (int k = 0; k < 3; ++k) CHECK(s->edge_midpoint(input.triangles[t][k], input.triangles[t][(k + 1) % 3]) == invalid_id);
+
+  // Splitting again reuses the freed slots and vertices before growing, and keeps every invariant.
+  random_selections(*s, input, 300, 9, 100);
+  CHECK(s->triangle_count() <= storage);
+  CHECK(s->vertex_count() <= vertices);
+  REQUIRE(s->split(leaf_ids(*s).front()).ok());
+  for (std::uint32_t c : s->created()) CHECK(s->triangle(c).parent != invalid_id);
+  CHECK_FALSE(s->created().empty());
+  check_invariants(*s, input);
+}
+
+TEST_CASE("subdivision: coarsen collapses whole subtrees, and nothing when a predicate refuses") {
+  const indexed_mesh input = infolerp::support::make_plane(2, 2, 2.0f);
+  auto s = subdivision_mesh::create(input);
+  REQUIRE(s.ok());
+  REQUIRE(s->split(0).ok());
+  const std::uint32_t child = s->triangle(0).first_child + 3;
+  REQUIRE(s->split(child).ok());
+  std::vector<std::uint32_t> ft, fv;
+  const auto yes = [](std::uint32_t) { return true; };
+  const auto no = [](std::uint32_t) { return false; };
+  CHECK_FALSE(s->coarsen(child, no, yes, ft, fv));  // refused by a triangle
+  CHECK_FALSE(s->coarsen(child, yes, no, ft, fv));  // refused by a vertex it created
+  CHECK_FALSE(s->coarsen(s->triangle(child).first_child, yes, yes, ft, fv));  // a leaf: nothing to collapse
+  CHECK(ft.empty());
+  CHECK(fv.empty());
+  CHECK(s->coarsen(0, yes, yes, ft, fv));  // the whole subtree, the split child's included
+  CHECK(s->triangle(child).retired == 3);
+  check_invariants(*s, input);
+  CHECK(s->leaf_count() == input.triangles.size());
 }

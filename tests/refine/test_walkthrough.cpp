@@ -4,7 +4,9 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <random>
 #include <set>
@@ -576,4 +578,90 @@ TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the curr
   }
   // A revisited view sends only what changed: the last frame is the first one's camera.
   CHECK(r.report().stage2.triangles_total < r.report().stage2.triangles);
+}
+
+TEST_CASE("walkthrough: memory_bytes covers the hierarchy, the cache and the view, and grows with refinement") {
+  auto r = make_agent();
+  REQUIRE(r.set_view(scene(), support::walkthrough_path(0, FRAMES, W, H)).ok());
+  r.shade_requests(shader(), serial_executor{});
+  // A floor from the sizes alone: two copies of the hierarchy's triangles and positions (the
+  // mesh and the one start() returns to), 12 bytes of colour and 1 of state per vertex, 4 bytes
+  // of leaf and 12 of weights per pixel.
+  const auto floor = [&] {
+    const subdivision_mesh& m = r.mesh();
+    return 2 * (m.original_triangle_count() * sizeof(subdivision_triangle)) + m.triangle_count() * sizeof(subdivision_triangle) +
+           m.vertex_count() * (sizeof(glm::vec3) + sizeof(glm::vec3) + 1) + std::size_t(W) * H * 16;
+  };
+  const std::size_t before = r.memory_bytes();
+  CHECK(before >= floor());
+  while (r.refine(shader(), {.batches = 4}) == refine_progress::refined) {
+  }
+  REQUIRE(r.mesh().triangle_count() > 4 * scene().mesh.triangles.size());
+  CHECK(r.memory_bytes() >= floor());
+  CHECK(r.memory_bytes() > before);
+}
+
+TEST_CASE("walkthrough: pruning never drops a leaf in view or a cached sample, along a walk out and back") {
+  // A street of 4 blocks walked to the far end and back, with a cache bound (evicted parts
+  // become prunable) and a hierarchy bound far below what the walk builds. At every view a copy
+  // of the agent that does not prune takes the same view: what the view shows (the image after
+  // its requests are delivered, bit for bit), what it requests and what stays cached must agree,
+  // so nothing pruned was in view, shown, cached or requested. (Refinement after that may differ:
+  // a split's closure reaches out-of-view neighbours, finer in the copy than in the pruned agent.)
+  auto built = support::make_long_street_scene(4);
+  REQUIRE(built.ok());
+  const support::walkthrough_scene& sc = *built;
+  auto s = subdivision_mesh::create(sc.mesh);
+  REQUIRE(s.ok());
+  auto made = progressive_refiner::create(
+      std::move(*s), {.criteria = {.min_pixels = 6.0f}, .max_cached_samples = 1000, .max_hierarchy_triangles = 3000});
+  REQUIRE(made.ok());
+  progressive_refiner b = std::move(*made);
+  auto shade = [&](const shading_point& sp) { return sc.shade(sp.position, sp.triangle); };
+  const auto requested = [&](progressive_refiner& r) {
+    std::vector<shading_point> req;
+    r.take_requests(req);
+    std::vector<std::uint32_t> ids;
+    std::vector<glm::vec3> colours;
+    std::vector<std::array<float, 3>> where;
+    for (const shading_point& sp : req)
+      ids.push_back(sp.vertex), colours.push_back(shade(sp)), where.push_back({sp.position.x, sp.position.y, sp.position.z});
+    REQUIRE(r.deliver(ids, colours).ok());
+    std::sort(where.begin(), where.end());
+    return where;
+  };
+  const auto cache = [](const progressive_refiner& r) {  // every cached sample: where, and its colour
+    std::vector<std::array<float, 6>> out;
+    for (std::size_t v = 0; v < r.mesh().vertex_count(); ++v)
+      if (r.vertex_shaded(v)) {
+        const glm::vec3 p = r.mesh().position(v), c = r.vertex_colour(v);
+        out.push_back({p.x, p.y, p.z, c.x, c.y, c.z});
+      }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  constexpr std::uint32_t path = 16;
+  std::size_t pruned_views = 0, largest = 0;
+  for (std::uint32_t step = 0; step <= 2 * path; ++step) {
+    const std::uint32_t f = step <= path ? step : 2 * path - step;  // out, then back the same way
+    const pinhole_camera cam = support::long_street_path(f, path + 1, 4, W, H);
+    progressive_refiner c = b;  // the same agent, not pruning
+    REQUIRE(c.set_hierarchy_bound(std::numeric_limits<std::size_t>::max()).ok());
+    REQUIRE(b.set_view(sc, cam).ok());
+    REQUIRE(c.set_view(sc, cam).ok());
+    INFO("step " << step);
+    CHECK(requested(b) == requested(c));
+    CHECK(same_bits(image_of(b), image_of(c)));
+    CHECK(b.cached_samples() == c.cached_samples());
+    CHECK(cache(b) == cache(c));
+    CHECK(b.visible_leaves().size() == c.visible_leaves().size());
+    pruned_views += b.mesh().live_triangle_count() < c.mesh().live_triangle_count();
+    largest = std::max(largest, b.mesh().live_triangle_count());
+    while (b.refine(shade, {.batches = 4}) == refine_progress::refined) {
+    }
+    display_delta delta;  // the visualizer takes the changes, as an engine does every frame
+    b.take_delta(delta);
+  }
+  CHECK(pruned_views >= 3);  // the bound was reached and pruning ran
+  CHECK(largest < 3 * 3000);  // a view change brings the hierarchy back toward the bound
 }

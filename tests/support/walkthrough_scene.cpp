@@ -42,6 +42,49 @@ glm::vec3 walkthrough_scene::shade(glm::vec3 p, std::uint32_t t) const {
   return albedo[t] * (0.18f + 0.85f * sun);
 }
 
+namespace {
+result<walkthrough_scene> commit(walkthrough_scene s) {
+  for (const glm::uvec3 t : s.mesh.triangles)
+    s.normal.push_back(glm::normalize(glm::cross(s.mesh.positions[t.y] - s.mesh.positions[t.x],
+                                                 s.mesh.positions[t.z] - s.mesh.positions[t.x])));
+  // The sun is behind the portico, so its shadows fall into the street toward the viewer.
+  s.to_sun = glm::normalize(glm::vec3(-0.4f, 0.55f, 0.5f));
+  s.device = std::make_unique<embree_device>();
+  s.tracer = std::make_unique<embree_scene>(*s.device);
+  if (auto id = s.tracer->add_mesh(s.mesh); !id) return id.error();
+  if (auto st = s.tracer->commit(); !st) return st;
+  return s;
+}
+}  // namespace
+
+result<walkthrough_scene> make_long_street_scene(std::uint32_t blocks) {
+  walkthrough_scene s;
+  for (std::uint32_t b = 0; b < blocks; ++b) {
+    const float y0 = 40.0f * float(b);
+    indexed_mesh ground = make_plane(4, 4, 40.0f);  // centred on the origin
+    const auto base = static_cast<unsigned>(s.mesh.positions.size());
+    for (glm::vec3 p : ground.positions) s.mesh.positions.push_back(p + glm::vec3(0.0f, y0, 0.0f));
+    for (glm::uvec3 t : ground.triangles) s.mesh.triangles.push_back(t + glm::uvec3(base));
+    s.albedo.resize(s.mesh.triangles.size(), glm::vec3(0.75f, 0.68f, 0.55f));
+    for (int i = 0; i < 6; ++i) {  // the portico runs along the street, on its left
+      const float y = y0 - 11.0f + 4.0f * float(i);
+      add_box(s.mesh, s.albedo, {-9.0f, y, 0.0f}, {-8.3f, y + 0.7f, 5.0f}, glm::vec3(0.85f, 0.83f, 0.78f));
+    }
+    add_box(s.mesh, s.albedo, {-10.0f, y0 - 12.0f, 5.0f}, {-5.6f, y0 + 11.5f, 5.6f}, glm::vec3(0.6f, 0.35f, 0.3f));
+    add_box(s.mesh, s.albedo, {-16.0f, y0 - 14.0f, 0.0f}, {-15.0f, y0 + 3.0f, 4.0f}, glm::vec3(0.7f, 0.62f, 0.5f));
+    add_box(s.mesh, s.albedo, {-3.0f, y0 + 8.0f, 0.0f}, {-1.8f, y0 + 9.2f, 10.0f}, glm::vec3(0.9f, 0.9f, 0.86f));
+  }
+  return commit(std::move(s));
+}
+
+pinhole_camera long_street_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t blocks, std::uint32_t width,
+                                std::uint32_t height) {
+  const float length = 40.0f * float(blocks > 1 ? blocks - 1 : 1);
+  const float y = -18.0f + length * float(frame) / float(frames > 1 ? frames - 1 : 1);
+  return {.eye = {0.0f, y, 5.5f}, .target = {0.0f, y + 20.0f, 1.0f}, .up = {0, 0, 1}, .vertical_fov_degrees = 55.0f,
+          .width = width, .height = height};
+}
+
 result<walkthrough_scene> make_walkthrough_scene() {
   walkthrough_scene s;
   // Ground: 40 × 40 m in 4 × 4 quads (32 triangles, 10 m each): vertex shading alone sees no shadow.
@@ -57,16 +100,7 @@ result<walkthrough_scene> make_walkthrough_scene() {
   add_box(s.mesh, s.albedo, {-16.0f, -14.0f, 0.0f}, {-15.0f, 3.0f, 4.0f}, glm::vec3(0.7f, 0.62f, 0.5f));
   // Temple column: tall, casting a long shadow across the street toward the viewer.
   add_box(s.mesh, s.albedo, {1.0f, -2.6f, 0.0f}, {2.2f, -1.4f, 10.0f}, glm::vec3(0.9f, 0.9f, 0.86f));
-  for (const glm::uvec3 t : s.mesh.triangles)
-    s.normal.push_back(glm::normalize(glm::cross(s.mesh.positions[t.y] - s.mesh.positions[t.x],
-                                                 s.mesh.positions[t.z] - s.mesh.positions[t.x])));
-  // The sun is behind the portico, so its shadows fall into the street toward the viewer.
-  s.to_sun = glm::normalize(glm::vec3(-0.4f, 0.55f, 0.5f));
-  s.device = std::make_unique<embree_device>();
-  s.tracer = std::make_unique<embree_scene>(*s.device);
-  if (auto id = s.tracer->add_mesh(s.mesh); !id) return id.error();
-  if (auto st = s.tracer->commit(); !st) return st;
-  return s;
+  return commit(std::move(s));
 }
 
 pinhole_camera walkthrough_camera(std::uint32_t width, std::uint32_t height) {

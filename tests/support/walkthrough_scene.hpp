@@ -50,6 +50,16 @@ pinhole_camera walkthrough_camera(walkthrough_view view, std::uint32_t width, st
 // the first half, back along the same way over the second (frame f and frames - 1 - f coincide).
 pinhole_camera walkthrough_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t width, std::uint32_t height);
 
+// A street of `blocks` repeated blocks along +y, each 40 m long with its own ground (4 × 4 quads,
+// no vertex shared with the next block), a portico of six columns under a roof slab, a wall and
+// a tall column, under the same low sun: a scene larger than any view, for walks that keep
+// entering new parts of it.
+result<walkthrough_scene> make_long_street_scene(std::uint32_t blocks);
+// Frame `frame` of a walk of `frames` cameras down the long street, from the first block to the
+// last, looking ahead: it never comes back.
+pinhole_camera long_street_path(std::uint32_t frame, std::uint32_t frames, std::uint32_t blocks, std::uint32_t width,
+                                std::uint32_t height);
+
 // The refiner's current image with the boundaries between the leaves under neighbouring
 // pixels drawn in a wire colour (so hidden edges are not drawn).
 image leaf_wireframe(const progressive_refiner& r, std::uint32_t width, std::uint32_t height);

@@ -5,16 +5,27 @@
 // each pixel, projected areas, vertex and pixel luminances) and names up to R leaves to split.
 //
 // Choices the paper leaves open, pinned down here:
-//  - All three criteria skip triangles that project onto fewer than `min_pixels` pixels (the
-//    paper states the 6-pixel rule for the NLD criteria; applying it to RND too keeps RND from
-//    spending samples below pixel size, which makes it a stronger baseline, not a weaker one).
+//  - All three criteria skip triangles whose area projected on the image plane is below
+//    `min_pixels` pixels (the paper states this 6-pixel rule for the NLD criteria; applying it
+//    to RND too keeps RND from spending samples below pixel size, and gives the three the same
+//    floor). The area comes from the view's pinhole projection (refinement_frame::projection,
+//    which progressive_refiner sets for a pinhole_camera); without one, the count of pixel
+//    centres the triangle covers stands in. That count is no bound on size: a sliver under one
+//    pixel centre counts 1 however small it is, so with min_pixels 1 a criterion could send one
+//    pixel's triangle down twenty levels, to corners that nearly coincide in float.
 //  - NLD_OS ranks its candidates: triangles above the `always_refine_fraction` of the image
 //    first (largest first), then by S (largest first), ties by id; it takes the first R.
 //  - NLD_IS is a best-first walk of the image quadtree: the quadrant with the largest S (over
-//    its four corner pixels) is expanded first; while S > S_req the triangle under its centre is
-//    selected (once) and its four sub-quadrants are queued, down to one pixel. It also ends
-//    (§4) once the samples requested in the current view reach `nld_is_pixel_fraction` of the
-//    pixel count (checked per batch, so the last batch may overshoot by its own requests).
+//    its four corner pixels) is expanded first; if S > S_req the triangle under its centre is
+//    selected (once), and in either case its four sub-quadrants are queued, down to one pixel
+//    (§4: every quadrant is subdivided; S_req gates the triangle's subdivision, not the
+//    recursion, so a feature inside a quadrant with equal corners is still found). It ends
+//    when a walk to pixel size selects nothing or (§4) once the samples requested in the
+//    current view reach `nld_is_pixel_fraction` of the pixel count (checked per batch, so the
+//    last batch may overshoot by its own requests; the paper gives no value, so the default is
+//    none).
+//  - No criterion selects a triangle whose split would give children with coinciding float
+//    corners (subdivision_mesh::splittable).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
@@ -33,6 +44,7 @@
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/refine/nld.hpp"
+#include "infolerp/refine/pinhole_camera.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 
 namespace infolerp {
@@ -97,6 +109,7 @@ struct refinement_frame {
   std::span<const float> vertex_luminance;         // per vertex (valid for vertices of visible leaves)
   float l_max = 0.0f;                              // L_max: largest luminance of the current image
   std::size_t view_samples = 0;                    // shading samples requested since the view was set
+  const pinhole_frame* projection = nullptr;       // the view's camera when it is a pinhole one (NLD_IS's areas)
 };
 
 // What a criterion keeps between batches (RND's random stream and point count).
@@ -111,9 +124,21 @@ inline float leaf_nld(const refinement_frame& f, std::uint32_t t) {
   const glm::uvec3 v = f.mesh->triangle(t).vertices;
   return nld(f.vertex_luminance[v.x], f.vertex_luminance[v.y], f.vertex_luminance[v.z], f.l_max);
 }
+// Leaf t's size for the min_pixels rule: its projected area in pixels with the frame's
+// projection, else the pixel centres it covers (see the prologue). O(1).
+inline double projected_pixels(const refinement_frame& f, std::uint32_t t) {
+  if (!f.projection) return double(f.leaf_pixels[t]);
+  const glm::uvec3 v = f.mesh->triangle(t).vertices;
+  return f.projection->projected_area(f.mesh->position(v.x), f.mesh->position(v.y), f.mesh->position(v.z));
+}
+// Large enough to refine (min_pixels; an infinite one admits nothing, not even a triangle
+// spanning the view) and small enough to split in float (splittable). O(1).
+inline bool qualifies(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
+  return std::isfinite(o.min_pixels) && projected_pixels(f, t) >= double(o.min_pixels) && f.mesh->splittable(t);
+}
 }  // namespace detail
 
-// NLD_OS (§4, §4.1): visible leaves with S > S_req and at least min_pixels pixels, plus leaves
+// NLD_OS (§4, §4.1): visible leaves with S > S_req and a size of at least min_pixels, plus leaves
 // covering more than always_refine_fraction of the image. Appends up to `limit` ids to `out`.
 // Complexity O(visible · log R); allocation O(candidates).
 inline void select_nld_os(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out,
@@ -129,7 +154,7 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
     const auto px = f.leaf_pixels[t];
     if (double(px) > o.always_refine_fraction * image) {
       c.push_back({true, float(px), t});
-    } else if (float(px) >= o.min_pixels) {
+    } else if (detail::qualifies(f, o, t)) {
       const float s = detail::leaf_nld(f, t);
       if (s > o.s_req) c.push_back({false, s, t});
     }
@@ -145,7 +170,8 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
 }
 
 // NLD_IS (§4): best-first quadtree walk over the interpolated image (see the header comment).
-// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited (Q <= 4/3 · pixels).
+// Appends up to R ids after what `out` holds. Complexity O(Q log Q) for the Q quadrants visited
+// (Q <= 4/3 · pixels; all of them in a batch that finds fewer than R); allocation O(Q).
 inline void select_nld_is(const refinement_frame& f, const criteria_options& o, std::vector<std::uint32_t>& out) {
   if (f.width == 0 || f.height == 0) return;
   if (double(f.view_samples) >= double(o.nld_is_pixel_fraction) * double(f.width) * double(f.height)) return;
@@ -176,10 +202,9 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
   while (!heap.empty() && out.size() < goal) {
     const quad q = heap.top();
     heap.pop();
-    if (!(q.s > o.s_req)) break;  // every other quadrant has an S at most this large
     const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
-    if (leaf != invalid_id && float(f.leaf_pixels[leaf]) >= o.min_pixels &&
-        std::find(chosen.begin(), chosen.end(), leaf) == chosen.end()) {
+    if (q.s > o.s_req && leaf != invalid_id && std::find(chosen.begin(), chosen.end(), leaf) == chosen.end() &&
+        detail::qualifies(f, o, leaf)) {
       chosen.push_back(leaf);
       out.push_back(leaf);
     }
@@ -207,7 +232,7 @@ inline void select_rnd(const refinement_frame& f, const criteria_options& o, cri
     ++st.points_drawn;
     const std::uint64_t p = st.rng.uniform(pixels);
     const std::uint32_t leaf = f.pixel_leaf[p];
-    if (leaf == invalid_id || float(f.leaf_pixels[leaf]) < o.min_pixels) continue;
+    if (leaf == invalid_id || !detail::qualifies(f, o, leaf)) continue;
     if (std::find(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), leaf) == out.end()) out.push_back(leaf);
   }
 }

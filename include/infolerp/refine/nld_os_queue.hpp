@@ -2,8 +2,8 @@
 // NLD_OS's selection (Oliveira, Santos, Proença, §4 and §4.1) kept between batches, so a batch
 // costs what it selects and what it made visible, not the whole visible set. select() returns
 // exactly what select_nld_os (criteria.hpp) returns on the same frame: the leaves above the
-// always-refine fraction first (largest first, ties by id), then those with S > S_req and at
-// least min_pixels pixels by S (largest first, ties by id).
+// always-refine fraction first (largest first, ties by id), then those with S > S_req and a
+// size of at least min_pixels (criteria.hpp) by S (largest first, ties by id).
 //
 // How: within one view a visible leaf keeps its pixel count until it is split, and its corners
 // are shaded (never evicted) whenever a selection runs, so its pair sum (nld.hpp, the numerator
@@ -34,6 +34,10 @@ class nld_os_queue {
     heap_.clear();
     forced_.clear();
   }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return (pending_.capacity() + forced_.capacity()) * sizeof(std::uint32_t) + heap_.capacity() * sizeof(entry) +
+           taken_.capacity() * sizeof(scored);
+  }
   // Leaf t gained pixels in the current view; its key is taken at the next select().
   void add(std::uint32_t t) { pending_.push_back(t); }
 
@@ -47,7 +51,7 @@ class nld_os_queue {
       const auto px = f.leaf_pixels[t];
       if (double(px) > o.always_refine_fraction * image) {
         forced_.push_back(t);
-      } else if (float(px) >= o.min_pixels) {
+      } else if (detail::qualifies(f, o, t)) {  // fixed for the view: corners and projection do not change
         const glm::uvec3 v = f.mesh->triangle(t).vertices;
         const float L[3] = {f.vertex_luminance[v.x], f.vertex_luminance[v.y], f.vertex_luminance[v.z]};
         heap_.push_back({nld_pair_sum(L), t});

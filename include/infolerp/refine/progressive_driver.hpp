@@ -12,6 +12,11 @@
 // 20 bytes per vertex plus 40 per hierarchy triangle. With max_cached_samples, vertices outside
 // the view are evicted least recently visible first; the current view's are never evicted, and
 // refinement stops (cache_full) once they alone reach the bound.
+// Hierarchy: with max_hierarchy_triangles, a new view that finds more triangles in use prunes
+// (subdivision_mesh::coarsen) subtrees outside the view, least recently in view first, down to
+// bound − bound/8: only subtrees none of whose triangles is in view, shown or awaiting a delta
+// and none of whose created vertices is cached or requested, so nothing the view shows changes.
+// Freed ids are reused by later splits. The current view's triangles are never pruned.
 // Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
 // hands out shading_points, deliver() takes colours for any subset in any order, from any thread
 // or machine (calls on one refiner must not overlap). shade_requests() is the synchronous adaptor.
@@ -40,6 +45,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <concepts>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -48,8 +54,8 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/executor.hpp"
@@ -58,45 +64,10 @@
 #include "infolerp/refine/criteria.hpp"
 #include "infolerp/refine/nld.hpp"
 #include "infolerp/refine/nld_os_queue.hpp"
+#include "infolerp/refine/pinhole_camera.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 
 namespace infolerp {
-
-// A pinhole camera: pixel (x, y), y down, gets the ray through its centre.
-struct pinhole_camera {
-  glm::vec3 eye{0.0f, 0.0f, 1.0f};     // camera position
-  glm::vec3 target{0.0f};              // looked-at point
-  glm::vec3 up{0.0f, 1.0f, 0.0f};      // world up (not parallel to target - eye)
-  float vertical_fov_degrees = 60.0f;  // full vertical field of view
-  std::uint32_t width = 320;           // image width in pixels
-  std::uint32_t height = 240;          // image height in pixels
-
-  // d / |d|: glm::normalize where the squared length is a normal float (so ordinary cameras keep
-  // their bits), scaled by the largest component first where it over- or underflows; (0,0,0)
-  // for a zero or non-finite d.
-  [[nodiscard]] static glm::vec3 unit(const glm::vec3& d) {
-    const float l2 = glm::dot(d, d);
-    if (std::isfinite(l2) && l2 >= std::numeric_limits<float>::min()) return glm::normalize(d);
-    const float scale = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-    return scale > 0.0f && std::isfinite(scale) ? glm::normalize(d / scale) : glm::vec3(0.0f);
-  }
-  // The unit view direction; (0,0,0) when eye and target coincide or target - eye overflows.
-  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) { return unit(target - eye); }
-
-  [[nodiscard]] ray primary_ray(std::uint32_t x, std::uint32_t y) const {
-    const glm::vec3 f = forward(eye, target);
-    const glm::vec3 r = unit(glm::cross(f, up));
-    const glm::vec3 u = glm::cross(r, f);
-    const float h = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
-    const float aspect = float(width) / float(height);
-    const float sx = (2.0f * (float(x) + 0.5f) / float(width) - 1.0f) * h * aspect;
-    const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(height)) * h;
-    ray out;
-    out.origin = eye;
-    out.direction = glm::normalize(f + sx * r + sy * u);
-    return out;
-  }
-};
 
 // What the shading callback gets for one vertex.
 struct shading_point {
@@ -109,7 +80,7 @@ struct shading_point {
 
 struct stage_figures {
   std::size_t triangles = 0;           // Δ: leaves shown
-  std::size_t triangles_total = 0;     // Δ_total: triangles ever shown
+  std::size_t triangles_total = 0;     // Δ_total: triangles sent to the visualizer since the view was set (Table 1)
   std::size_t triangles_produced = 0;  // every triangle the hierarchy holds
   std::size_t shading_samples = 0;     // vertices shaded so far
   double seconds = 0.0;                // wall time since the run started
@@ -127,6 +98,7 @@ struct driver_options {
   std::size_t max_shading_samples = std::numeric_limits<std::size_t>::max();  // stop once this many vertices are shaded
   std::size_t max_batches = std::numeric_limits<std::size_t>::max();          // stop after this many batches
   std::size_t max_cached_samples = std::numeric_limits<std::size_t>::max();  // cache bound (>= 1), see the prologue
+  std::size_t max_hierarchy_triangles = std::numeric_limits<std::size_t>::max();  // hierarchy bound (>= 1), see the prologue
   glm::vec3 background{0.0f};                                              // colour of pixels without a hit or shown triangle
   std::size_t grain = 4096;                                                // executor grain (pixels, vertices)
 };
@@ -186,6 +158,7 @@ class id_set {
     sorted_ = sorted_ && i == ids_.size();
   }
   [[nodiscard]] std::size_t size() const noexcept { return ids_.size(); }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept { return (ids_.capacity() + pos_.capacity()) * sizeof(std::uint32_t); }
   [[nodiscard]] std::span<const std::uint32_t> unordered() const noexcept { return ids_; }
   // O(n log n) after a change that broke the order, O(1) otherwise.
   [[nodiscard]] std::span<const std::uint32_t> sorted() const {
@@ -219,6 +192,8 @@ class progressive_refiner {
     if (options.grain == 0) return make_error(errc::bad_parameter, no_element, "driver_options.grain must be >= 1");
     if (options.max_cached_samples == 0)
       return make_error(errc::bad_parameter, no_element, "driver_options.max_cached_samples must be >= 1");
+    if (options.max_hierarchy_triangles == 0)
+      return make_error(errc::bad_parameter, no_element, "driver_options.max_hierarchy_triangles must be >= 1");
     progressive_refiner r;
     r.initial_mesh_ = mesh;
     r.mesh_ = std::move(mesh);
@@ -427,7 +402,17 @@ class progressive_refiner {
     return {};
   }
 
-  // The current image: per pixel the colours of the shown triangle over it interpolated, or the
+  // Bounds the hierarchy (see the prologue), applied at the next view. Errors: a bound of 0;
+  // then nothing changes.
+  status set_hierarchy_bound(std::size_t max_hierarchy_triangles) {
+    if (max_hierarchy_triangles == 0) return make_error(errc::bad_parameter, no_element, "hierarchy bound must be >= 1");
+    options_.max_hierarchy_triangles = max_hierarchy_triangles;
+    prune_retry_ = 0;
+    return {};
+  }
+
+  // The current image: per pixel the colours of the shown triangle over it interpolated (each
+  // channel kept within its corners' range, so inside the range of what was delivered), or the
   // background. Preconditions: image.size() == width·height, a view was set. O(pixels), no
   // allocation.
   void reconstruct(std::span<glm::vec3> image) const {
@@ -451,6 +436,18 @@ class progressive_refiner {
   // Shaded values held now, and samples delivered since start() (evicted ones shaded again count twice).
   [[nodiscard]] std::size_t cached_samples() const noexcept { return shaded_count_; }
   [[nodiscard]] std::size_t samples_delivered() const noexcept { return samples_; }
+  // Bytes the refiner holds: the hierarchy (and the copy start() returns to), the cache and the
+  // per-triangle, per-vertex and per-view buffers, by capacity. O(1).
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    const auto b = [](const auto&... v) { return ((v.capacity() * sizeof(typename std::remove_cvref_t<decltype(v)>::value_type)) + ...); };
+    return initial_mesh_.memory_bytes() + mesh_.memory_bytes() + nld_os_.memory_bytes() + visible_.memory_bytes() +
+           shown_.memory_bytes() +
+           b(pixel_leaf_, pixel_weights_, leaf_pixels_, in_view_, display_of_, decision_, decided_, shown_mark_, leaf_head_,
+             pixel_next_, fresh_, split_, green_first_, lum_tree_, tree_level_, tree_next_, dirty_, dirty_mark_, shown_above_,
+             merged_, scratch_, shown_count_, waiters_, waiter_head_, waiter_clock_, touched_, seeds_, stack_, vstate_,
+             colour_, luminance_, last_seen_, delivered_epoch_, to_issue_, in_sent_, listed_, changed_, path_, evict_,
+             selected_, freed_triangles_, freed_vertices_);
+  }
   // The frame the criteria see (pixel luminances filled only for NLD_IS).
   [[nodiscard]] refinement_frame frame() const {
     refinement_frame f;
@@ -465,6 +462,7 @@ class progressive_refiner {
     f.vertex_luminance = luminance_;
     f.l_max = l_max_;
     f.view_samples = view_requests_;
+    f.projection = has_projection_ ? &projection_ : nullptr;
     return f;
   }
 
@@ -505,6 +503,14 @@ class progressive_refiner {
     return {};
   }
 
+  // The rays a camera makes: its frame computed once (pinhole_camera::frame()) when it has one,
+  // else the camera itself.
+  template <class Camera>
+  static decltype(auto) rays_of(const Camera& camera) {
+    if constexpr (requires { camera.frame(); }) return camera.frame();
+    else return (camera);
+  }
+
   // Traces and checks the view; only then (optionally) restarts and takes the view.
   template <class T, class Camera, class E>
   status view(const T& tracer, const Camera& camera, E&& exec, bool restart) {
@@ -527,10 +533,11 @@ class progressive_refiner {
     hits.resize(n);
     for_each_chunk(exec, n, options_.grain, [&](std::size_t, std::size_t begin, std::size_t end) {
       std::array<ray, primary_block> rays;  // on the stack: no allocation per chunk
+      const auto& cam = rays_of(camera);
       for (std::size_t b = begin; b < end; b += primary_block) {
         const std::size_t m = std::min(primary_block, end - b);
         for (std::size_t i = 0; i < m; ++i)
-          rays[i] = camera.primary_ray(static_cast<std::uint32_t>((b + i) % width), static_cast<std::uint32_t>((b + i) / width));
+          rays[i] = cam.primary_ray(static_cast<std::uint32_t>((b + i) % width), static_cast<std::uint32_t>((b + i) / width));
         trace_intersect(tracer, std::span<const ray>(rays.data(), m), std::span<hit>(hits.data() + b, m));
       }
     });
@@ -587,6 +594,7 @@ class progressive_refiner {
     clock_ = 0;
     view_requests_ = 0;
     delta_epoch_ = 0;
+    prune_retry_ = 0;
     shown_.reset();
   }
 
@@ -594,6 +602,8 @@ class progressive_refiner {
   void apply_view(const Camera& camera, const std::vector<hit>& hits, E&& exec,
                   std::chrono::steady_clock::time_point began) {
     started_ = began;
+    if constexpr (requires { { camera.frame() } -> std::convertible_to<pinhole_frame>; }) projection_ = camera.frame(), has_projection_ = true;
+    else has_projection_ = false;
     width_ = camera.width;
     height_ = camera.height;
     finished_ = false;
@@ -637,19 +647,16 @@ class progressive_refiner {
       select_for_refinement(f, options_.criteria, state_, selected_, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
         nld_os_.select(f, options_.criteria, ids, limit);
       });
-      const auto first_new = static_cast<std::uint32_t>(mesh_.triangle_count());
       if (selected_.empty()) {
         finished_ = true;
         report_.stage2 = figures();
         return b == 0 ? refine_progress::finished : refine_progress::refined;
       }
-      for (std::uint32_t t : selected_) {
-        [[maybe_unused]] const status st = mesh_.split(t);
-        INFOLERP_ASSERT(st.ok());
-      }
+      [[maybe_unused]] const status st = mesh_.split(selected_);  // in order, as split(t) one by one
+      INFOLERP_ASSERT(st.ok());
       ++report_.batches;
       report_.selections += selected_.size();
-      follow_splits(first_new);
+      follow_splits();
       render(exec);
       report_.stage2 = figures();
     }
@@ -663,7 +670,10 @@ class progressive_refiner {
     if (d == invalid_id) return options_.background;
     const glm::uvec3 v = mesh_.triangle(d).vertices;
     const glm::vec3 w = d == leaf ? pixel_weights_[p] : weights_in(d, leaf, pixel_weights_[p]);
-    return w.x * colour_[v.x] + w.y * colour_[v.y] + w.z * colour_[v.z];
+    const glm::vec3 a = colour_[v.x], b = colour_[v.y], c = colour_[v.z];
+    // Inside the corners' range, as exact interpolation is: the stored weights' rounding (a few
+    // ulps per re-location) must not carry a pixel past what was delivered.
+    return glm::clamp(w.x * a + w.y * b + w.z * c, glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)));
   }
   // The barycentric weights in ancestor a of the point with weights w in leaf l (planar).
   [[nodiscard]] glm::vec3 weights_in(std::uint32_t a, std::uint32_t l, glm::vec3 w) const {
@@ -759,6 +769,49 @@ class progressive_refiner {
     stamp_in_view(fresh_);
     enforce_cache_bound();
     update_display();
+    prune_hierarchy();
+  }
+
+  // The hierarchy bound (see the prologue): the largest subtrees outside the view (split
+  // triangles out of view whose parent is in view, or roots), least recently in view first
+  // (ties by id), each collapsed with what its split edges tie it to when nothing it holds is
+  // in view, shown, awaiting a delta, cached or requested. O(triangles · log) per call that
+  // prunes, once per bound/8 growth: a call that cannot reach bound − bound/8 (what is left is
+  // in view or cached) waits until the hierarchy grew by bound/8 more.
+  void prune_hierarchy() {
+    const std::size_t bound = options_.max_hierarchy_triangles;
+    if (mesh_.live_triangle_count() <= bound || mesh_.live_triangle_count() < prune_retry_) return;
+    const std::size_t target = bound - bound / 8;
+    evict_.clear();
+    for (std::uint32_t t = 0; t < mesh_.triangle_count(); ++t) {
+      const subdivision_triangle& n = mesh_.triangle(t);
+      if (n.child_count == 0 || n.retired || in_view_[t] == clock_) continue;
+      if (n.parent == invalid_id || in_view_[n.parent] == clock_) evict_.push_back(t);
+    }
+    std::sort(evict_.begin(), evict_.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return in_view_[a] != in_view_[b] ? in_view_[a] < in_view_[b] : a < b; });
+    const auto allow_triangle = [&](std::uint32_t t) {
+      return in_view_[t] != clock_ && !in_sent_[t] && !listed_[t] && !shown_.contains(t);
+    };
+    const auto allow_vertex = [&](std::uint32_t v) { return vstate_[v] == unshaded && last_seen_[v] != clock_; };
+    for (std::uint32_t t : evict_) {
+      if (mesh_.live_triangle_count() <= target) break;
+      if (mesh_.triangle(t).child_count == 0) continue;  // collapsed with an earlier one
+      freed_triangles_.clear();
+      freed_vertices_.clear();
+      if (!mesh_.coarsen(t, allow_triangle, allow_vertex, freed_triangles_, freed_vertices_)) continue;
+      for (std::uint32_t x : mesh_.coarsened()) green_first_[x] = invalid_id;
+      for (std::uint32_t x : freed_triangles_) {
+        leaf_pixels_[x] = 0, leaf_head_[x] = invalid_id, green_first_[x] = invalid_id, in_sent_[x] = 0, listed_[x] = 0;
+        in_view_[x] = 0, display_of_[x] = invalid_id, dirty_mark_[x] = 0, shown_count_[x] = 0, decided_[x] = 0;
+        shown_mark_[x] = 0, decision_[x] = display_step{};
+      }
+      for (std::uint32_t v : freed_vertices_) {
+        waiter_head_[v] = invalid_id, waiter_clock_[v] = 0, vstate_[v] = unshaded, colour_[v] = glm::vec3(0.0f);
+        luminance_[v] = 0.0f, last_seen_[v] = 0, delivered_epoch_[v] = 0;
+      }
+    }
+    prune_retry_ = mesh_.live_triangle_count() > target ? mesh_.live_triangle_count() + bound / 8 : 0;
   }
 
   // The first children of every 1:2 split (their parent's 1:4 resplit retires both).
@@ -769,11 +822,11 @@ class progressive_refiner {
   }
 
   // The visible leaves a batch's splits took out of the leaf set, found from the triangles it
-  // created (ids from first_new on): a split leaf is the parent of new children, a retired 1:2
-  // child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
-  void find_split_leaves(std::uint32_t first_new) {
+  // created (subdivision_mesh::created): a split leaf is the parent of new children, a retired
+  // 1:2 child is a child of a parent resplit 1:4. Ascending. O(new triangles · log).
+  void find_split_leaves() {
     split_.clear();
-    for (std::uint32_t c = first_new; c < mesh_.triangle_count(); ++c) {
+    for (std::uint32_t c : mesh_.created()) {
       const std::uint32_t p = mesh_.triangle(c).parent;
       const subdivision_triangle& n = mesh_.triangle(p);
       if (n.first_child != c) continue;  // one visit per split (a 1:2 split resplit in this batch has another first child)
@@ -793,9 +846,9 @@ class progressive_refiner {
   // pixels, and only the new leaves are walked up for the in-view marks and requests (the
   // in-view set of a view only grows). O(new triangles · log + pixels of the split leaves · level)
   // (the visible set is an id_set: O(1) per leaf that leaves or enters).
-  void follow_splits(std::uint32_t first_new) {
+  void follow_splits() {
     grow();
-    find_split_leaves(first_new);
+    find_split_leaves();
     fresh_.clear();
     begin_display_update();
     for (std::uint32_t t : split_) {
@@ -1097,6 +1150,8 @@ class progressive_refiner {
   driver_options options_;
   criterion_state state_;
   std::uint32_t width_ = 0, height_ = 0;
+  pinhole_frame projection_;     // the view's camera, when it is a pinhole one (NLD_IS's projected areas)
+  bool has_projection_ = false;
   std::vector<std::uint32_t> pixel_leaf_;
   std::vector<glm::vec3> pixel_weights_;
   std::vector<std::uint32_t> leaf_pixels_;
@@ -1148,6 +1203,8 @@ class progressive_refiner {
   std::vector<std::uint8_t> in_sent_, listed_;  // per triangle: shown at the last delta; in changed_
   std::vector<std::uint32_t> changed_;         // triangles whose membership changed since the last delta
   std::vector<std::uint32_t> path_, evict_;
+  std::vector<std::uint32_t> freed_triangles_, freed_vertices_;  // prune_hierarchy()'s, per coarsen
+  std::size_t prune_retry_ = 0;  // prune_hierarchy() waits until this many triangles are in use
   std::vector<std::uint32_t> selected_;
   float l_max_ = 0.0f;
   std::size_t samples_ = 0;

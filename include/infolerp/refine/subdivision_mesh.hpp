@@ -63,7 +63,7 @@ struct subdivision_triangle {
   std::uint8_t child_count = 0;             // 0 (leaf or retired), 2 (1:2 split) or 4 (1:4 split)
   std::uint8_t split_edge = 0;              // for a 1:2 split: the bisected edge k (corner k to k+1)
   std::uint8_t retired = 0;                 // 1 or 2: first or second 1:2 child, replaced by the parent's 1:4 split
-                                            // (split_edge then keeps the parent's bisected edge)
+                                            // (split_edge then keeps the parent's bisected edge); 3: a free slot
   [[nodiscard]] bool is_leaf() const noexcept { return child_count == 0 && retired == 0; }
 };
 
@@ -91,6 +91,7 @@ class edge_table {
     if (cap > slots_.size()) rehash(cap);
   }
   [[nodiscard]] std::size_t size() const noexcept { return count_; }
+  [[nodiscard]] std::size_t memory_bytes() const noexcept { return slots_.capacity() * sizeof(entry); }
 
   [[nodiscard]] const entry* find(std::uint32_t a, std::uint32_t b) const noexcept {
     if (slots_.empty()) return nullptr;
@@ -118,6 +119,26 @@ class edge_table {
       }
     }
     return slots_[i];
+  }
+  // Removes the entry of (a, b) if present (backward-shift deletion keeps every probe chain
+  // intact). Invalidates references from get().
+  void erase(std::uint32_t a, std::uint32_t b) noexcept {
+    if (slots_.empty()) return;
+    const std::uint64_t k = key(a, b);
+    std::size_t i = slot(k);
+    for (; slots_[i].key != k; i = (i + 1) & mask_)
+      if (slots_[i].key == empty_key) return;
+    for (std::size_t j = i;;) {  // shift later members of the chain back into the hole at i
+      j = (j + 1) & mask_;
+      if (slots_[j].key == empty_key) break;
+      const std::size_t home = slot(slots_[j].key);
+      const bool between = i <= j ? (i < home && home <= j) : (i < home || home <= j);  // home in (i, j]: stays
+      if (between) continue;
+      slots_[i] = slots_[j];
+      i = j;
+    }
+    slots_[i].key = empty_key;
+    --count_;
   }
   // Adds a leaf to the edge; false when the edge already has two (a non-manifold edge).
   static bool add_face(entry& e, std::uint32_t t) noexcept {
@@ -243,6 +264,7 @@ class subdivision_mesh {
     s.vertex_source_.assign(nv, invalid_id);
     for (std::size_t v = 0; v < nv; ++v) s.positions_[v] = mesh_position(m, v);
     s.tris_.resize(nt);
+    s.retired_first_.assign(nt, invalid_id);
     s.edges_.reserve(3 * nt / 2 + 3);
     for (std::size_t t = 0; t < nt; ++t) {
       const glm::uvec3 tri = mesh_triangle(m, t);
@@ -288,6 +310,22 @@ class subdivision_mesh {
   [[nodiscard]] const subdivision_triangle& triangle(std::size_t t) const { return tris_[t]; }
   [[nodiscard]] std::span<const subdivision_triangle> triangles() const noexcept { return tris_; }
   [[nodiscard]] bool is_leaf(std::size_t t) const { return tris_[t].is_leaf(); }
+  // Bytes held by the hierarchy: triangles, vertices, the edge table and the closure's queue
+  // (capacities, so what the allocator holds). O(1).
+  [[nodiscard]] std::size_t memory_bytes() const noexcept {
+    return tris_.capacity() * sizeof(subdivision_triangle) + positions_.capacity() * sizeof(glm::vec3) +
+           vertex_source_.capacity() * sizeof(std::uint32_t) + edges_.memory_bytes() + queue_.capacity() * sizeof(pending);
+  }
+  // Whether a 1:4 split of t gives children whose corners are distinct in float: every edge's
+  // midpoint, as a split computes it, differs from both ends and from the other midpoints. False
+  // once t is so small against its coordinates that halving an edge no longer moves (about 23
+  // levels below a triangle of the size of its coordinates); refinement stops there. O(1).
+  [[nodiscard]] bool splittable(std::uint32_t t) const {
+    const glm::uvec3 v = tris_[t].vertices;
+    const glm::vec3 a = positions_[v.x], b = positions_[v.y], c = positions_[v.z];
+    const glm::vec3 m0 = midpoint(a, b), m1 = midpoint(b, c), m2 = midpoint(c, a);
+    return m0 != a && m0 != b && m1 != b && m1 != c && m2 != c && m2 != a && m0 != m1 && m1 != m2 && m2 != m0;
+  }
   // The midpoint vertex of edge (a, b), or invalid_id.
   [[nodiscard]] std::uint32_t edge_midpoint(std::uint32_t a, std::uint32_t b) const noexcept {
     return edges_.midpoint(a, b);
@@ -302,6 +340,7 @@ class subdivision_mesh {
   status split(std::uint32_t t, std::uint32_t propagation_depth) {
     if (t >= tris_.size())
       return make_error(errc::index_out_of_range, t, "triangle ", t, " out of range (", tris_.size(), " triangles)");
+    created_.clear();
     select(t, propagation_depth);
     return {};
   }
@@ -312,8 +351,70 @@ class subdivision_mesh {
       if (selected[i] >= tris_.size())
         return make_error(errc::index_out_of_range, selected[i], "selection ", i, ": triangle ", selected[i],
                           " out of range (", tris_.size(), " triangles)");
+    created_.clear();
     for (std::uint32_t t : selected) select(t, options_.propagation_depth);
     return {};
+  }
+  // The triangles the last split() call made (reused slots included: after coarsen(), a new
+  // triangle's id may be smaller than older ones'). Valid until the next split or coarsen.
+  [[nodiscard]] std::span<const std::uint32_t> created() const noexcept { return created_; }
+  // Triangles in use: triangle_count() less the slots coarsen() freed and no split reused yet.
+  [[nodiscard]] std::size_t live_triangle_count() const noexcept {
+    return tris_.size() - 4 * free4_.size() - 2 * free2_.size();
+  }
+
+  // The triangles the last successful coarsen() made leaves again.
+  [[nodiscard]] std::span<const std::uint32_t> coarsened() const noexcept { return component_; }
+  // The inverse of split, for memory: collapses the subtree under t, and under every triangle
+  // tied to it across an edge that a collapsed subtree splits (transitively), so the mesh stays
+  // conforming: each becomes a leaf again. Only when allow_triangle(x) holds for each triangle
+  // of those subtrees and allow_vertex(v) for each vertex they created; otherwise nothing
+  // changes. Freed triangle slots (1:2 children a 1:4 split retired included) and vertex ids are
+  // appended to freed_triangles and freed_vertices and reused by later splits. Returns whether
+  // it collapsed. Complexity O(collapsed · log) expected; allocation: the work and free lists.
+  template <class AllowTriangle, class AllowVertex>
+  bool coarsen(std::uint32_t t, AllowTriangle&& allow_triangle, AllowVertex&& allow_vertex,
+               std::vector<std::uint32_t>& freed_triangles, std::vector<std::uint32_t>& freed_vertices) {
+    if (t >= tris_.size() || !collect_component(t, allow_triangle, allow_vertex)) return false;
+    created_.clear();
+    for (std::uint32_t d : subtree_) {  // every edge inside a collapsed subtree goes (its member's own edges stay)
+      std::uint32_t x = d;  // the member d lies in: a subtree's edges lie inside it or on its edges
+      while (tris_[x].parent != invalid_id && mark_[tris_[x].parent] == mark_clock_) x = tris_[x].parent;
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = tris_[d].vertices[k], b = tris_[d].vertices[(k + 1) % 3];
+        if (!(has_vertex(x, a) && has_vertex(x, b))) edges_.erase(a, b);
+      }
+    }
+    for (std::uint32_t x : component_) {  // the members' own edges: no midpoint, the member as a face
+      for (int k = 0; k < 3; ++k) {
+        auto& e = edges_.get(tris_[x].vertices[k], tris_[x].vertices[(k + 1) % 3]);
+        for (std::uint32_t f : {e.face[0], e.face[1]})
+          if (f != invalid_id && mark_[f] == mark_clock_ && f != x) detail::edge_table::remove_face(e, f);
+        e.midpoint = invalid_id;
+      }
+    }
+    for (std::uint32_t x : component_)
+      for (int k = 0; k < 3; ++k) {
+        [[maybe_unused]] const bool ok = detail::edge_table::add_face(edges_.get(tris_[x].vertices[k], tris_[x].vertices[(k + 1) % 3]), x);
+        INFOLERP_ASSERT(ok);
+      }
+    blocks_.clear();  // the child blocks, all read before any is freed (freeing clears a slot)
+    for (const auto* list : {&subtree_, &component_})
+      for (std::uint32_t d : *list) {
+        const subdivision_triangle& n = tris_[d];
+        if (retired_first_[d] != invalid_id) blocks_.push_back({retired_first_[d], 2}), retired_first_[d] = invalid_id;
+        if (n.child_count == 0 || n.retired) continue;
+        leaf_count_ -= n.child_count - 1u;
+        blocks_.push_back({n.first_child, n.child_count});
+      }
+    for (const block& b : blocks_) free_block(b.first, b.size, freed_triangles);
+    for (std::uint32_t x : component_) {
+      tris_[x].first_child = invalid_id;
+      tris_[x].child_count = 0;
+      tris_[x].split_edge = 0;
+    }
+    for (std::uint32_t v : vertices_) free_vertices_.push_back(v), freed_vertices.push_back(v);
+    return true;
   }
 
   // The leaf containing the point with Embree barycentrics (u, v) in original triangle
@@ -452,6 +553,7 @@ class subdivision_mesh {
   // triangles and vertices plus a work list of leaf ids. needs_split is called serially.
   template <class NeedsSplit>
   std::size_t tessellate(NeedsSplit&& needs_split, std::uint32_t max_level = 8) {
+    created_.clear();
     std::size_t selections = 0;
     std::vector<std::uint32_t> work;
     for (;;) {
@@ -485,6 +587,9 @@ class subdivision_mesh {
     else if (k == 1) w1 = a, w2 = b, w0 = c;
     else w2 = a, w0 = b, w1 = c;
   }
+  // Halves first: the sum of two coordinates near ±FLT_MAX overflows (a fuzz find); for
+  // normal numbers the result is the same bits as 0.5 * (a + b).
+  static glm::vec3 midpoint(glm::vec3 a, glm::vec3 b) noexcept { return 0.5f * a + 0.5f * b; }
   static constexpr std::uint32_t closure_only = std::numeric_limits<std::uint32_t>::max() / 2;
 
   // Barycentric weights of vertex v's position in original triangle t (least squares in the
@@ -549,10 +654,16 @@ class subdivision_mesh {
     const auto m = static_cast<std::uint32_t>(positions_.size());
     e.midpoint = m;
     if (e.face[0] != invalid_id) queue_.push_back({e.face[0], depth + 1});
-    // Halves first: the sum of two coordinates near ±FLT_MAX overflows (a fuzz find); for
-    // normal numbers the result is the same bits as 0.5 * (a + b).
-    positions_.push_back(0.5f * positions_[a] + 0.5f * positions_[b]);
+    positions_.push_back(midpoint(positions_[a], positions_[b]));
     vertex_source_.push_back(tris_[t].original);
+    if (!free_vertices_.empty()) {  // a vertex freed by coarsen(): reuse its id
+      const std::uint32_t r = free_vertices_.back();
+      free_vertices_.pop_back();
+      positions_[r] = positions_.back(), vertex_source_[r] = vertex_source_.back();
+      positions_.pop_back(), vertex_source_.pop_back();
+      e.midpoint = r;
+      return r;
+    }
     return m;
   }
   // Attaches child c to edge (a, b); queues it when (a, b) already has a midpoint.
@@ -572,8 +683,22 @@ class subdivision_mesh {
   void detach(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     detail::edge_table::remove_face(edges_.get(a, b), c);
   }
-  std::uint32_t add_child(std::uint32_t parent, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-    const auto id = static_cast<std::uint32_t>(tris_.size());
+  // The ids of n = 2 or 4 new children, consecutive: a block freed by coarsen() or new slots.
+  std::uint32_t alloc_children(std::uint32_t n) {
+    std::vector<std::uint32_t>& free = n == 4 ? free4_ : free2_;
+    std::uint32_t first;
+    if (!free.empty()) {
+      first = free.back();
+      free.pop_back();
+    } else {
+      first = static_cast<std::uint32_t>(tris_.size());
+      tris_.resize(tris_.size() + n);
+      retired_first_.resize(tris_.size(), invalid_id);
+    }
+    for (std::uint32_t i = 0; i < n; ++i) created_.push_back(first + i);
+    return first;
+  }
+  void set_child(std::uint32_t id, std::uint32_t parent, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     subdivision_triangle n;
     n.vertices = {a, b, c};
     n.parent = parent;
@@ -581,8 +706,8 @@ class subdivision_mesh {
     // Saturates: 255 nested selections are legal input (float positions stopped changing
     // about 30 levels earlier), so the count stops instead of asserting or wrapping to 0.
     n.level = static_cast<std::uint8_t>(std::min(tris_[parent].level + 1, 255));
-    tris_.push_back(n);
-    return id;
+    tris_[id] = n;
+    retired_first_[id] = invalid_id;
   }
 
   void split_red(std::uint32_t t, std::uint32_t depth) {
@@ -590,10 +715,11 @@ class subdivision_mesh {
     const std::uint32_t m0 = make_midpoint(v[0], v[1], t, depth);
     const std::uint32_t m1 = make_midpoint(v[1], v[2], t, depth);
     const std::uint32_t m2 = make_midpoint(v[2], v[0], t, depth);
-    const std::uint32_t c0 = add_child(t, v[0], m0, m2);
-    const std::uint32_t c1 = add_child(t, m0, v[1], m1);
-    const std::uint32_t c2 = add_child(t, m2, m1, v[2]);
-    const std::uint32_t c3 = add_child(t, m0, m1, m2);
+    const std::uint32_t c0 = alloc_children(4), c1 = c0 + 1, c2 = c0 + 2, c3 = c0 + 3;
+    set_child(c0, t, v[0], m0, m2);
+    set_child(c1, t, m0, v[1], m1);
+    set_child(c2, t, m2, m1, v[2]);
+    set_child(c3, t, m0, m1, m2);
     tris_[t].first_child = c0;
     tris_[t].child_count = 4;
     leaf_count_ += 3;
@@ -614,8 +740,9 @@ class subdivision_mesh {
     const std::uint32_t m = make_midpoint(a, b, t, closure_only);
     detach(b, c, t);
     detach(c, a, t);
-    const std::uint32_t c0 = add_child(t, a, m, c);
-    const std::uint32_t c1 = add_child(t, m, b, c);
+    const std::uint32_t c0 = alloc_children(2), c1 = c0 + 1;
+    set_child(c0, t, a, m, c);
+    set_child(c1, t, m, b, c);
     tris_[t].first_child = c0;
     tris_[t].child_count = 2;
     tris_[t].split_edge = static_cast<std::uint8_t>(k);
@@ -625,6 +752,110 @@ class subdivision_mesh {
     attach(b, c, c1, false);
     attach(c, a, c0, false);
     attach_inner(m, c, c0, c1);
+  }
+
+  // coarsen()'s work: component_, the triangles to become leaves (none inside another's
+  // subtree); subtree_, the triangles under them that are not members, retired ones included,
+  // each marked with mark_clock_ (members too); vertices_, the vertices those created. The
+  // triangle across a member's split edge (a, b) is the first ancestor with that edge of a leaf
+  // along it. False if a predicate refuses or the edge table is not what a split leaves.
+  template <class AllowTriangle, class AllowVertex>
+  bool collect_component(std::uint32_t t, AllowTriangle& allow_triangle, AllowVertex& allow_vertex) {
+    if (mark_.size() < tris_.size()) mark_.resize(tris_.size(), 0);
+    if (++mark_clock_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), mark_clock_ = 1;
+    component_.clear();
+    subtree_.clear();
+    vertices_.clear();
+    stack_.assign(1, t);
+    while (!stack_.empty()) {
+      std::uint32_t x = stack_.back();
+      stack_.pop_back();
+      while (tris_[x].parent != invalid_id && mark_[tris_[x].parent] == mark_clock_) x = tris_[x].parent;
+      if (mark_[x] == mark_clock_) continue;  // a member already, or inside one's subtree
+      const subdivision_triangle& n = tris_[x];
+      if (n.child_count == 0 || n.retired || !allow_triangle(x)) return false;
+      mark_[x] = mark_clock_;
+      component_.push_back(x);
+      // x's subtree (a member found earlier inside it becomes part of it; its own subtree is
+      // listed already)
+      walk_.assign(1, x);
+      while (!walk_.empty()) {
+        const std::uint32_t d = walk_.back();
+        walk_.pop_back();
+        const subdivision_triangle& m = tris_[d];
+        if (d != x) {
+          if (mark_[d] == mark_clock_) {
+            if (const auto it = std::find(component_.begin(), component_.end(), d); it != component_.end())
+              component_.erase(it), subtree_.push_back(d);
+            continue;
+          }
+          if (!allow_triangle(d)) return false;
+          mark_[d] = mark_clock_;
+          subtree_.push_back(d);
+        }
+        if (retired_first_[d] != invalid_id) walk_.push_back(retired_first_[d]), walk_.push_back(retired_first_[d] + 1);
+        if (m.retired || m.child_count == 0) continue;
+        // The vertices d's split created (a 1:4 split's centre child, a 1:2 split's middle
+        // corner), checked at once so a refusal costs little.
+        const glm::uvec3 created = tris_[m.first_child + (m.child_count == 4 ? 3 : 0)].vertices;
+        for (int k = m.child_count == 4 ? 0 : 1; k < (m.child_count == 4 ? 3 : 2); ++k) {
+          if (!allow_vertex(created[k])) return false;
+          vertices_.push_back(created[k]);
+        }
+        for (std::uint32_t c = m.first_child; c < m.first_child + m.child_count; ++c) walk_.push_back(c);
+      }
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = n.vertices[k], b = n.vertices[(k + 1) % 3];
+        if (edges_.midpoint(a, b) == invalid_id) continue;
+        std::uint32_t y = invalid_id;
+        if (!across(x, a, b, a, b, y)) return false;
+        if (y != invalid_id) stack_.push_back(y);
+      }
+    }
+    // The vertices the collapsed subtrees created (a midpoint shared by two splits once), less
+    // any member's corner.
+    std::sort(vertices_.begin(), vertices_.end());
+    vertices_.erase(std::unique(vertices_.begin(), vertices_.end()), vertices_.end());
+    corners_.clear();
+    for (std::uint32_t x : component_)
+      for (int k = 0; k < 3; ++k) corners_.push_back(tris_[x].vertices[k]);
+    std::sort(corners_.begin(), corners_.end());
+    vertices_.erase(std::remove_if(vertices_.begin(), vertices_.end(),
+                                   [&](std::uint32_t v) { return std::binary_search(corners_.begin(), corners_.end(), v); }),
+                    vertices_.end());
+    return true;
+  }
+  // The triangle across edge (A, B) of x, found along the segment (a, b) of it: y, or invalid_id
+  // on a boundary. False if the table has no entry for a segment.
+  bool across(std::uint32_t x, std::uint32_t a, std::uint32_t b, std::uint32_t A, std::uint32_t B, std::uint32_t& y) const {
+    const detail::edge_table::entry* e = edges_.find(a, b);
+    if (!e) return false;
+    if (e->midpoint != invalid_id) {
+      const std::uint32_t m = e->midpoint;
+      if (!across(x, a, m, A, B, y)) return false;
+      return y != invalid_id || across(x, m, b, A, B, y);
+    }
+    for (std::uint32_t f : e->face) {
+      std::uint32_t z = f;
+      while (z != invalid_id && !(has_vertex(z, A) && has_vertex(z, B))) z = tris_[z].parent;
+      if (z != invalid_id && z != x) {
+        y = z;
+        return true;
+      }
+    }
+    return true;
+  }
+  [[nodiscard]] bool has_vertex(std::uint32_t t, std::uint32_t v) const noexcept {
+    const glm::uvec3 w = tris_[t].vertices;
+    return w.x == v || w.y == v || w.z == v;
+  }
+  void free_block(std::uint32_t first, std::uint32_t n, std::vector<std::uint32_t>& freed) {
+    for (std::uint32_t c = first; c < first + n; ++c) {
+      tris_[c] = subdivision_triangle{};
+      tris_[c].retired = 3;
+      freed.push_back(c);
+    }
+    (n == 4 ? free4_ : free2_).push_back(first);
   }
 
   // Rule 3: undo the 1:2 split of p and split it 1:4.
@@ -640,6 +871,7 @@ class subdivision_mesh {
       auto& e = edges_.get(n.vertices[k], n.vertices[(k + 1) % 3]);
       detail::edge_table::add_face(e, p);
     }
+    retired_first_[p] = n.first_child;
     n.child_count = 0;
     n.first_child = invalid_id;
     leaf_count_ -= 1;
@@ -653,6 +885,16 @@ class subdivision_mesh {
   std::vector<subdivision_triangle> tris_;
   detail::edge_table edges_;
   std::vector<pending> queue_;
+  std::vector<std::uint32_t> retired_first_;  // per triangle resplit 1:4: its retired 1:2 children's first id
+  std::vector<std::uint32_t> free4_, free2_, free_vertices_;  // freed by coarsen(), reused by splits
+  std::vector<std::uint32_t> created_;        // triangles made since the last take_created()
+  std::vector<std::uint32_t> component_, subtree_, vertices_, corners_, stack_, walk_;  // coarsen()'s work lists
+  struct block {
+    std::uint32_t first, size;
+  };
+  std::vector<block> blocks_;        // coarsen(): the child blocks to free
+  std::vector<std::uint32_t> mark_;  // coarsen(): mark_clock_ on the members and their subtrees
+  std::uint32_t mark_clock_ = 0;
   std::size_t head_ = 0;
   std::uint32_t limit_ = 0;  // propagation depth of the current selection
   std::size_t original_count_ = 0;
