@@ -28,8 +28,9 @@
 //   ibuffer_occl      the I-Buffer whose compatibility test also bounds the AO / soft-shadow
 //                     difference (§4.1's extension to other high-frequency signals)
 //   denoise_atrous    what engines ship: primary + sun ray, n AO and m soft-shadow rays per pixel
-//                     (rotated per pixel), 5 iterations of the edge-avoiding à-trous filter on the
-//                     two visibility planes (upsample_denoise.hpp); filter_seconds: the filter alone.
+//                     (rotated per pixel, in 16-ray packets), 5 iterations of the edge-avoiding
+//                     à-trous filter on the two visibility planes (upsample_denoise.hpp);
+//                     filter_seconds: the filter alone.
 //                     Then, per denoiser row, the best I-Buffer row within its time is printed.
 //   full_rotated      (with denoise_atrous) the reference's ray counts with the denoiser's rotated
 //                     ray sets, unfiltered: the distance of an equally converged image from the

@@ -24,7 +24,8 @@
 //                     (demodulated: AO and soft-shadow visibility, never albedo or texture).
 //   denoise_renderer  the demo's shading with n AO and m soft-shadow rays per pixel (the
 //                     reference shader's hemisphere and light-point sets, Cranley-Patterson
-//                     rotated by a per-pixel hash so that the error is noise, not bands), then
+//                     rotated by a per-pixel hash so that the error is noise, not bands; traced in
+//                     16-ray packets, as the harness's fastest per-pixel row), then
 //                     the filter on the two visibility planes, then shade() per pixel. The
 //                     primary ray and the sun's hard-shadow ray are traced at every pixel.
 //
@@ -39,6 +40,7 @@
 #include <cstdint>
 #include <cstring>
 #include <span>
+#include <utility>
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/core/executor.hpp"
@@ -232,6 +234,7 @@ class denoise_renderer {
     constexpr float pi = 3.14159265358979323846f;
     const support::demo_scene& scene = primary_->scene();
     const support::pinhole_rays& cam = primary_->camera_rays();
+    ray_batch batch{&scene.tracer};
     for (int x = 0; x < w_; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x);
       std::uint64_t rays = 0;
@@ -250,30 +253,52 @@ class denoise_renderer {
       const glm::vec3 origin = in.position + scene.ray_offset * ng;
       const glm::vec2 rot = rotation(x, y);
       if (soft_rays_ > 0) {
-        unsigned visible = 0;
         const glm::vec3 light_normal = scene.area.normal();
         for (unsigned k = 0; k < soft_rays_; ++k) {
           const glm::vec2 s = hammersley(k, soft_rays_);
           const glm::vec3 d = scene.area.point(wrap(s.x + rot.x), wrap(s.y + rot.y)) - origin;
           if (glm::dot(d, ng) <= 0.0f || glm::dot(d, light_normal) >= 0.0f) continue;
-          visible += scene.tracer.occluded(ray{origin, 0.0f, d, 0.9999f}) ? 0u : 1u;
+          batch.push(ray{origin, 0.0f, d, 0.9999f});
         }
-        soft_[i] = static_cast<float>(visible) / static_cast<float>(soft_rays_);
+        soft_[i] = static_cast<float>(batch.unoccluded()) / static_cast<float>(soft_rays_);
       }
       if (ao_rays_ > 0) {
         glm::vec3 t, b;
         detail::tangent_frame(ng, t, b);
-        unsigned visible = 0;
         for (unsigned k = 0; k < ao_rays_; ++k) {
           const glm::vec2 s = hammersley(k, ao_rays_);
           const float u = wrap(s.x + rot.x), r = std::sqrt(u), phi = 2.0f * pi * wrap(s.y + rot.y);
           const glm::vec3 d = r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u)) * ng;
-          visible += scene.tracer.occluded(ray{origin, 0.0f, d, scene.ao_radius}) ? 0u : 1u;
+          batch.push(ray{origin, 0.0f, d, scene.ao_radius});
         }
-        ao_[i] = static_cast<float>(visible) / static_cast<float>(ao_rays_);
+        ao_[i] = static_cast<float>(batch.unoccluded()) / static_cast<float>(ao_rays_);
       }
     }
   }
+
+  // A pixel's rays of one kind, traced through the tracer's batch call (16-ray packets, as the
+  // harness's full_packets16 traces the reference's rays); one per row, on the row's thread.
+  struct ray_batch {
+    const support::embree_scene* tracer;
+    std::array<ray, 64> rays{};
+    std::size_t count = 0;
+    unsigned visible = 0;
+    void push(const ray& r) {
+      if (count == rays.size()) flush();
+      rays[count++] = r;
+    }
+    void flush() {
+      if (count == 0) return;
+      std::array<std::uint8_t, 64> occluded{};
+      tracer->occluded(std::span<const ray>(rays.data(), count), std::span<std::uint8_t>(occluded.data(), count));
+      for (std::size_t k = 0; k < count; ++k) visible += occluded[k] ? 0u : 1u;
+      count = 0;
+    }
+    unsigned unoccluded() {  // of the rays pushed since the last call
+      flush();
+      return std::exchange(visible, 0u);
+    }
+  };
 
   const support::reference_shader* primary_;
   const support::reference_shader* shading_;

@@ -19,7 +19,7 @@
 //                    the sources cannot vouch for it, AO and soft shadow interpolated), min_sources 1;
 //                    "probe where sources differ": probe_every_sample off, a probe only where the
 //                    sources of a new sample differ ("or normals > 5 deg": the ready source's
-//                    default smooth_angle; without it, smooth_angle infinite)
+//                    default smooth_angle, also 2.5 and 10 deg; without it, smooth_angle infinite)
 //   *_hand           the hand-written source in the same setting (the ready source's cost ratio)
 //   denoise_atrous   n AO + m soft-shadow rays per pixel and the edge-avoiding à-trous filter
 //                    (upsample_denoise.hpp); --csv FILE appends every row of both scenes to FILE,
@@ -327,7 +327,13 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
   auto refine = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(shader, clusters, o.width, o.height);
   auto refine_flat = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(
       shader, clusters, o.width, o.height, true, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity());
-  if (!ready || !refine || !refine_flat) return std::fprintf(stderr, "ray_cast_source failed\n"), 1;
+  // smooth_angle 2.5 and 10 degrees beside the default (5), for the default's choice.
+  constexpr float degree = 3.14159265f / 180.0f;
+  auto refine_fine = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(
+      shader, clusters, o.width, o.height, true, std::numeric_limits<float>::infinity(), 2.5f * degree);
+  auto refine_coarse = sup::make_demo_ray_cast_source<infolerp::probe_mode::refine>(
+      shader, clusters, o.width, o.height, true, std::numeric_limits<float>::infinity(), 10.0f * degree);
+  if (!ready || !refine || !refine_flat || !refine_fine || !refine_coarse) return std::fprintf(stderr, "ray_cast_source failed\n"), 1;
   const sup::demo_ibuffer_source hand{&shader, &clusters, o.width, o.height};
   sup::demo_refining_probe_source hand_refine;
   static_cast<sup::demo_ibuffer_source&>(hand_refine) = hand;
@@ -348,6 +354,10 @@ int run_scene(const std::string& title, const sup::demo_scene& scene, const text
   for (std::uint32_t p : {4u, 5u, 6u})
     rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ",
                     ibuffer(*refine_flat, p, 1, o.threads, o.width, o.height, false), {}});
+  for (const auto& [src, angle] : {std::pair{&*refine_fine, "2.5"}, {&*refine_coarse, "10"}})
+    for (std::uint32_t p : {4u, 5u, 6u})
+      rows.push_back({"ibuffer_refine", std::to_string(p) + " passes, min 1 src, probe where sources differ or normals > " + angle + " deg",
+                      ibuffer(*src, p, 1, o.threads, o.width, o.height, false), {}});
   rows.push_back({"ibuffer_hand", "4 passes", ibuffer(hand, 4, 2, o.threads, o.width, o.height), {}});
   rows.push_back({"ibuffer_refine_hand", "5 passes, min 1 src", ibuffer(hand_refine, 5, 1, o.threads, o.width, o.height), {}});
   for (const auto& [n, m] : {std::pair{1u, 1u}, {2u, 1u}, {4u, 1u}, {4u, 2u}, {8u, 2u}, {16u, 4u}}) {

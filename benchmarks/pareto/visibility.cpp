@@ -19,7 +19,7 @@
 // (rtcOccluded1M, flagged coherent) instead of 16-ray packets.
 // Beside the CSV: FILE.png (seconds against mean_js, gnuplot) and FILE.gp (its script), with a
 // trailing .csv of FILE replaced.
-// Also printed: min and median seconds per row, the peak RSS of the process, and per mesh the
+// Also printed: min and median seconds per row (wall, and the process's CPU time), the peak RSS of the process, and per mesh the
 // peak memory (VmHWM) of a forked child that loads the mesh, builds the Embree scenes and runs
 // one prepare() of the default, of the largest image and of the neighbour rule, against the
 // child's VmHWM before prepare() and the T·N bytes of counts.
@@ -34,6 +34,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <span>
@@ -51,6 +52,14 @@
 namespace {
 
 using namespace infolerp;
+
+// CPU time of the whole process: the harness is serial (one Embree thread), so this is the
+// configuration's own work, less moved than wall time by the other processes of a shared machine.
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 // Forwards to Embree and counts the rays it is asked about.
 struct counting_tracer {
@@ -288,14 +297,16 @@ int pareto_visibility(int argc, char** argv) {
     std::atomic<std::size_t> ray_count{0};
     const counting_tracer tracer{&scene, &ray_count}, stream_tracer{&stream_scene, &ray_count};
     serial_executor exec;
-    std::vector<std::vector<double>> seconds(cfg.size());
+    std::vector<std::vector<double>> seconds(cfg.size()), cpu(cfg.size());
     std::vector<prepared_visibility_channel> prepared(cfg.size());
     std::vector<std::size_t> rays(cfg.size());
     for (int r = 0; r < reps; ++r)
       for (std::size_t c = 0; c < cfg.size(); ++c) {
         ray_count = 0;
         const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = process_cpu_seconds();
         auto p = cfg[c].channel.prepare(*m, *topo, cfg[c].stream ? stream_tracer : tracer, exec);
+        cpu[c].push_back(process_cpu_seconds() - c0);
         seconds[c].push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         if (!p) {
           std::fprintf(stderr, "%s: %s\n", cfg[c].option.c_str(), p.error().message().c_str());
@@ -333,10 +344,11 @@ int pareto_visibility(int argc, char** argv) {
       const double median = s[s.size() / 2];
       std::fprintf(csv, "%s,%s,%s,%.4f,%zu,%.6g,%.6g,%.6f,%.6f\n", name.c_str(), cfg[c].option.c_str(),
                    cfg[c].setting.c_str(), median, rays[c], sum / static_cast<double>(nt), worst, ari, ari_self);
-      std::printf("%-17s %-26s %-10s min %.3f median %.3f s (%.3fx default median)  rays %zu  ari %.4f\n", name.c_str(),
-                  cfg[c].option.c_str(), cfg[c].setting.c_str(), s.front(), median,
-                  median / [&] { std::vector<double> d = seconds[0]; std::sort(d.begin(), d.end()); return d[d.size() / 2]; }(),
-                  rays[c], ari);
+      const auto median_of = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v[v.size() / 2]; };
+      std::printf("%-17s %-26s %-10s min %.3f median %.3f s (%.3fx default median), CPU min %.3f median %.3f s (%.3fx)"
+                  "  rays %zu  ari %.4f\n", name.c_str(), cfg[c].option.c_str(), cfg[c].setting.c_str(), s.front(), median,
+                  median / median_of(seconds[0]), *std::min_element(cpu[c].begin(), cpu[c].end()), median_of(cpu[c]),
+                  median_of(cpu[c]) / median_of(cpu[0]), rays[c], ari);
     }
     std::fflush(csv);
     std::printf("%s: %zu triangles, ari_self %.4f, peak RSS %.0f MB\n", name.c_str(), nt, ari_self, peak_rss_mb());
