@@ -354,18 +354,19 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
 #endif
 
 // Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
-// points. Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
+// points (weighted ones too, vertex_points::weight), in columns 2σ_max / columns_per_ball wide.
+// Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
 // tiles of span × span columns in 6 phases by (tile x mod 2, tile y mod 3): the tiles of one
 // phase write disjoint points, so they run in parallel, and every point receives its terms in
 // an order fixed by the data: identical bits for any executor, thread count and grain (tiles
 // per task).
 template <class E>
 std::vector<double> exact_gaussian_averages(E& exec, const vertex_points& pg, const std::vector<double>& sigma,
-                                            std::size_t grain) {
+                                            std::size_t grain, double columns_per_ball = 3.0) {
   const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
-  const column_grid g = make_column_grid(exec, pg, rmax / 3.0);
+  const column_grid g = make_column_grid(exec, pg, rmax / columns_per_ball);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
   const std::size_t stride = g.stride;
   std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums
