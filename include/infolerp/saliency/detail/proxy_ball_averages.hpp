@@ -115,15 +115,21 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   }
   // Blend: points in cell order (so that neighbouring points read neighbouring proxies), each
   // proxy's position and average side by side.
+  // The σ run in parallel, each serially: a proxy's kernel is small, and 8 parallel phases per σ
+  // cost more than they gain when other processes share the cores (OpenMP barriers).
   std::vector<std::vector<std::array<double, 4>>> at_proxy(L);
-  for (std::size_t u = 0; u < L; ++u) {
-    const vertex_points& q = proxies[u].points;
-    // Columns one ball wide: a proxy has about (4·cells_per_sigma)² neighbours in a ball, too few
-    // for the exact kernel's narrower columns to pay for their overhead (3x slower at 2 cells per σ).
-    const std::vector<double> a = exact_gaussian_averages(exec, q, {sigma[u]}, grain, 1.0);
-    at_proxy[u].resize(a.size());
-    for (std::size_t i = 0; i < a.size(); ++i) at_proxy[u][i] = {q.x[i], q.y[i], q.z[i], a[i]};
-  }
+  exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t u = b; u < e; ++u) {
+      const vertex_points& q = proxies[u].points;
+      // Columns one ball wide: a proxy has about (4·cells_per_sigma)² neighbours in a ball, too
+      // few for the exact kernel's narrower columns to pay for their overhead (3x slower at 2
+      // cells per σ).
+      serial_executor serial;
+      const std::vector<double> a = exact_gaussian_averages(serial, q, {sigma[u]}, grain, 1.0);
+      at_proxy[u].resize(a.size());
+      for (std::size_t i = 0; i < a.size(); ++i) at_proxy[u][i] = {q.x[i], q.y[i], q.z[i], a[i]};
+    }
+  });
   const std::vector<std::uint32_t>& order = proxies[0].order;
   std::vector<double> sx(P), sy(P), sz(P);
   for (std::size_t i = 0; i < P; ++i) sx[i] = pts.x[order[i]], sy[i] = pts.y[order[i]], sz[i] = pts.z[order[i]];
