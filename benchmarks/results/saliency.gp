@@ -7,7 +7,7 @@ set logscale x
 set key top right
 set grid
 set xlabel 'seconds (compute_saliency, 2 threads, min of 3)'
-lbl(c) = strcol(2) eq 'exact' ? 'exact' : (strcol(2) eq 'default' ? '' : sprintf('c=%s', strcol(3)))
+lbl(c) = strcol(2) eq 'exact' ? (strcol(3) eq '' ? 'exact' : 'exact, eps x1.001') : (strcol(2) eq 'default' ? '' : sprintf('c=%s', strcol(3)))
 set ylabel 'relative L2 to exact'
 plot for [m in 'bunny00 bunny00_x4 bunny00_x16'] 'saliency.csv' using (strcol(1) eq m ? $5 : 1/0):6 with points pt 7 title m, \
      '' using 5:6:(lbl(0)) with labels font ',7' offset 0,0.7 notitle
