@@ -77,15 +77,15 @@ struct mesh_saliency {
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; method not one of the three,
-// epsilon <= 0 or not finite, no
-// scales or more than 16 (counted as given, repeats included), a scale <= 0 or not finite,
-// flat_level_threshold negative or not finite, proxy_cells_per_sigma not positive and finite or
-// so large that the finest proxy grid would need 2^21 cells along the bounding-box diagonal, a σ
-// (scale × epsilon × diagonal) below ~1.5e-154 or above ~3.3e153, where σ² underflows or 16σ²
-// overflows (bad_parameter); a
-// mesh whose bounding box has zero diagonal (degenerate_triangle).
+// epsilon <= 0 or not finite, no scales or more than 16 (counted as given, repeats included), a
+// scale <= 0 or not finite, flat_level_threshold negative or not finite, proxy_cells_per_sigma
+// not positive and finite or (proxy) so large that the finest proxy grid would need 2^21 cells
+// along the bounding-box diagonal, a σ (scale × epsilon × diagonal) below ~1.5e-154 or above
+// ~3.3e153, where σ² underflows or 16σ² overflows (bad_parameter); a mesh whose bounding box has
+// zero diagonal (degenerate_triangle).
 // Complexity: exact O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
-// unordered pairs within 2σ_max, each evaluated once); proxy O(σs · (V log V + proxy pairs)).
+// unordered pairs within 2σ_max, each evaluated once); proxy O(V log V + T + σs · (V + proxy
+// pairs)), the proxy pairs about (4·proxy_cells_per_sigma)² per proxy point.
 // Allocation O(V·σs) (exact: 3 doubles per vertex and distinct σ, 64 at most; proxy: about 6
 // more per vertex and σ; never per pair). Parallel through exec; the result is identical for
 // every executor and thread count.

@@ -8,10 +8,10 @@
 // exact to rounding (exact_gaussian_averages), and each point receives the blend of the averages
 // at the proxies within h of it, weights (1 − d²/h²)², or its own cell's when none is that near.
 // Accuracy follows cells_per_sigma: with cells smaller than the point spacing every cell holds
-// one point and the result is the exact one. Cost per σ: O(P log P) to group, the proxy's pairs
-// within 2σ (about (4·cells_per_sigma)² per proxy point on a surface, whatever the mesh's
-// resolution), 27 cells per point to blend. Allocation O(P) per σ. Sums run in an order fixed by
-// the data: identical bits for any executor and thread count.
+// one point and the result is the exact one. Cost: O(P log P) once to group the points; per σ,
+// the proxy's pairs within 2σ (about (4·cells_per_sigma)² per proxy point on a surface, whatever
+// the mesh's resolution) and 27 cells per point to blend. Allocation O(P) per σ. Sums run in
+// an order fixed by the data: identical bits for any executor and thread count.
 #include <algorithm>
 #include <array>
 #include <cmath>
