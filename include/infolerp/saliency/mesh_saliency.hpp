@@ -64,7 +64,7 @@ struct saliency_options {
   std::size_t grain = 1;                           // tiles of 3 × 3 columns per parallel task
   saliency_method method = saliency_method::automatic;
   std::size_t exact_below = 200000;                // automatic: exact below this many referenced vertices
-  double proxy_cells_per_sigma = 2.0;              // proxy: cells per σ along an axis (accuracy against time)
+  double proxy_cells_per_sigma = 4.0;              // proxy: cells per σ along an axis (accuracy against time)
 };
 
 struct mesh_saliency {
