@@ -32,7 +32,8 @@ void BM_Saliency_Exact(benchmark::State& state) {
   const auto* m = elephant_subdivided();
   if (!m) return state.SkipWithError("refined_elephant not found");
   for (auto _ : state) {
-    auto s = infolerp::compute_saliency(*m, {}, infolerp::openmp_executor{static_cast<int>(state.range(0))});
+    auto s = infolerp::compute_saliency(*m, {.method = infolerp::saliency_method::exact},
+                                        infolerp::openmp_executor{static_cast<int>(state.range(0))});
     if (!s.ok()) return state.SkipWithError(s.error().message().c_str());
     benchmark::DoNotOptimize(s->saliency.data());
   }

@@ -13,6 +13,8 @@
 [[gnu::weak]] int pareto_walk(int argc, char** argv);
 [[gnu::weak]] int pareto_lod(int argc, char** argv);
 [[gnu::weak]] int pareto_visibility(int argc, char** argv);
+[[gnu::weak]] int pareto_saliency(int argc, char** argv);
+[[gnu::weak]] int pareto_pipeline(int argc, char** argv);
 
 // PSNR in dB of image a against reference b on linear colours clamped to [0, 1] (99 when equal),
 // as the refinement harnesses measure it.

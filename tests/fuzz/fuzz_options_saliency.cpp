@@ -19,6 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                 .grain = r.count<std::size_t>()};
   for (unsigned k = 0, n = r.u8() % 5u; k < n; ++k) so.scales.push_back(r.real());
   if (flags & 1) so = {};  // the defaults, so the later stages see saliency more often
+  if (flags & 4) so.method = infolerp::saliency_method::proxy;  // the approximation at any size
   const infolerp::salient_clustering_options co{.clusters = r.count<std::uint32_t>(), .pool_multiplier = r.real(),
                                                 .normal_weight = r.real(), .seed = r.count<std::uint64_t>(),
                                                 .max_iterations = r.count<std::uint32_t>(),

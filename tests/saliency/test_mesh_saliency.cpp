@@ -212,3 +212,162 @@ TEST_CASE("saliency: bad input gets a clear status") {
   point.triangles = {{0, 0, 0}};
   CHECK(infolerp::compute_saliency(point).error().code() == infolerp::errc::degenerate_triangle);
 }
+
+namespace {
+
+// A unit icosphere with Gaussian bumps (height, angular width in radians) along the given
+// directions: its salient features are known.
+infolerp::indexed_mesh bumpy_sphere(unsigned level, const std::vector<glm::vec3>& dirs, float height, float width) {
+  auto m = infolerp::support::make_icosphere(level);
+  for (auto& p : m.positions) {
+    const glm::vec3 n = glm::normalize(p);
+    float r = 1.0f;
+    for (const glm::vec3& d : dirs) {
+      const float a = std::acos(std::clamp(glm::dot(n, glm::normalize(d)), -1.0f, 1.0f));
+      r += height * std::exp(-a * a / (2.0f * width * width));
+    }
+    p = n * r;
+  }
+  return m;
+}
+
+const std::vector<glm::vec3> bump_dirs = {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}, {-1, -1, 1}, {1, -1, -1}};
+
+infolerp::saliency_options proxy_options(double cells_per_sigma, double epsilon) {
+  return {.epsilon = epsilon, .method = infolerp::saliency_method::proxy, .proxy_cells_per_sigma = cells_per_sigma};
+}
+
+double relative_l2(const std::vector<double>& a, const std::vector<double>& ref) {
+  double d = 0.0, n = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) d += (a[i] - ref[i]) * (a[i] - ref[i]), n += ref[i] * ref[i];
+  return std::sqrt(d / n);
+}
+
+// Share of ref's 10% most salient vertices that a also ranks in its 10% most salient.
+double top10_overlap(const std::vector<double>& a, const std::vector<double>& ref) {
+  const std::size_t k = a.size() / 10;
+  auto top = [&](const std::vector<double>& s) {
+    std::vector<std::size_t> order(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return s[x] != s[y] ? s[x] > s[y] : x < y; });
+    std::vector<char> mask(s.size(), 0);
+    for (std::size_t i = 0; i < k; ++i) mask[order[i]] = 1;
+    return mask;
+  };
+  const auto ta = top(a), tr = top(ref);
+  std::size_t both = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) both += ta[i] && tr[i];
+  return static_cast<double>(both) / static_cast<double>(k);
+}
+
+}  // namespace
+
+TEST_CASE("saliency proxy: the error falls as the cells per sigma grow, down to exact") {
+  // epsilon 0.02: the mesh's vertex spacing is about half of ε, so coarse cells group many vertices.
+  const auto m = bumpy_sphere(5, bump_dirs, 0.15f, 0.2f);
+  const double epsilon = 0.02;
+  auto exact = infolerp::compute_saliency(m, {.epsilon = epsilon, .method = infolerp::saliency_method::exact});
+  REQUIRE(exact.ok());
+  CHECK(exact->method == infolerp::saliency_method::exact);
+  double previous = std::numeric_limits<double>::infinity();
+  for (double cells : {0.5, 1.0, 2.0, 4.0, 8.0}) {
+    auto s = infolerp::compute_saliency(m, proxy_options(cells, epsilon));
+    REQUIRE(s.ok());
+    CHECK(s->method == infolerp::saliency_method::proxy);
+    const double err = relative_l2(s->saliency, exact->saliency);
+    INFO("cells per sigma " << cells << ": relative L2 " << err << ", previous " << previous);
+    CHECK(err < previous);
+    previous = err;
+  }
+  // Cells smaller than the vertex spacing / sqrt(3) (even for the largest sigma) hold one
+  // vertex each: the proxy is the mesh and the result exact's.
+  double spacing = std::numeric_limits<double>::infinity();
+  for (const auto& t : m.triangles)
+    for (int e = 0; e < 3; ++e)
+      spacing = std::min(spacing, static_cast<double>(glm::distance(m.positions[t[e]], m.positions[t[(e + 1) % 3]])));
+  const double cells = 12.0 * exact->epsilon * 2.0 / spacing;  // largest σ = 12ε, cell edge spacing / 2
+  auto fine = infolerp::compute_saliency(m, proxy_options(cells, epsilon));
+  REQUIRE(fine.ok());
+  const double d = max_abs_diff(fine->saliency, exact->saliency);
+  INFO("cells per sigma " << cells << ": max |proxy - exact| " << d);
+  CHECK(d <= 1e-9);
+}
+
+TEST_CASE("saliency proxy: the 10% most salient vertices of a sphere with bumps are exact's") {
+  const auto m = bumpy_sphere(5, bump_dirs, 0.15f, 0.2f);
+  for (double epsilon : {0.01, 0.02}) {
+    auto exact = infolerp::compute_saliency(m, {.epsilon = epsilon, .method = infolerp::saliency_method::exact});
+    auto proxy = infolerp::compute_saliency(m, {.epsilon = epsilon, .method = infolerp::saliency_method::proxy});
+    REQUIRE(exact.ok());
+    REQUIRE(proxy.ok());
+    const double overlap = top10_overlap(proxy->saliency, exact->saliency);
+    INFO("epsilon " << epsilon << ": top-10% overlap " << overlap << ", relative L2 "
+                    << relative_l2(proxy->saliency, exact->saliency));
+    CHECK(overlap >= 0.9);
+    // The features are the bumps: most of the proxy's top 10% lies on one (within 3 widths) when
+    // the scales are the bumps' (at epsilon 0.02 the largest σ spans 0.8 radians).
+    if (epsilon != 0.01) continue;
+    const std::size_t k = m.positions.size() / 10;
+    std::vector<std::size_t> order(m.positions.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return proxy->saliency[x] > proxy->saliency[y]; });
+    std::size_t on_bump = 0;
+    for (std::size_t i = 0; i < k; ++i)
+      for (const glm::vec3& d : bump_dirs)
+        if (std::acos(std::clamp(glm::dot(glm::normalize(m.positions[order[i]]), glm::normalize(d)), -1.0f, 1.0f)) < 0.6f) {
+          ++on_bump;
+          break;
+        }
+    INFO("epsilon " << epsilon << ": " << on_bump << " of " << k << " on a bump");
+    CHECK(on_bump >= k * 9 / 10);
+  }
+}
+
+TEST_CASE("saliency proxy: identical bits for any executor and thread count") {
+  const auto m = bumpy_sphere(4, bump_dirs, 0.15f, 0.2f);
+  for (double cells : {1.0, 2.0, 5.0}) {
+    const auto opt = proxy_options(cells, 0.02);
+    auto serial = infolerp::compute_saliency(m, opt);
+    REQUIRE(serial.ok());
+    for (unsigned workers : {2u, 3u, 4u}) {
+      auto par = infolerp::compute_saliency(m, opt, infolerp::support::thread_pool_executor{workers});
+      REQUIRE(par.ok());
+      CHECK(par->saliency == serial->saliency);
+      CHECK(par->levels == serial->levels);
+    }
+  }
+}
+
+TEST_CASE("saliency: the automatic method is exact below exact_below referenced vertices, proxy from there") {
+  const auto m = bumpy_sphere(3, bump_dirs, 0.15f, 0.2f);
+  const std::size_t nv = m.positions.size();
+  auto below = infolerp::compute_saliency(m, {.exact_below = nv + 1});
+  auto at = infolerp::compute_saliency(m, {.exact_below = nv});
+  REQUIRE(below.ok());
+  REQUIRE(at.ok());
+  CHECK(below->method == infolerp::saliency_method::exact);
+  CHECK(at->method == infolerp::saliency_method::proxy);
+  CHECK(infolerp::compute_saliency(m)->method == infolerp::saliency_method::exact);  // default: 200,000
+}
+
+TEST_CASE("saliency proxy: bad parameters get a clear status") {
+  const auto m = infolerp::support::make_icosphere(2);
+  for (double cells : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    INFO("proxy_cells_per_sigma " << cells);
+    auto r = infolerp::compute_saliency(m, proxy_options(cells, 0.003));
+    REQUIRE(!r.ok());
+    CHECK(r.error().code() == infolerp::errc::bad_parameter);
+    CHECK(r.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  }
+  // Cells so small that the grid would need 2^21 along the diagonal: refused, not wrapped.
+  auto tiny = infolerp::compute_saliency(m, proxy_options(1e5, 0.003));
+  REQUIRE(!tiny.ok());
+  CHECK(tiny.error().code() == infolerp::errc::bad_parameter);
+  CHECK(tiny.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  // The same setting is not used, so not refused, by the exact method.
+  CHECK(infolerp::compute_saliency(m, {.method = infolerp::saliency_method::exact, .proxy_cells_per_sigma = 1e5}).ok());
+  auto bad_method = infolerp::compute_saliency(m, {.method = static_cast<infolerp::saliency_method>(7)});
+  REQUIRE(!bad_method.ok());
+  CHECK(bad_method.error().code() == infolerp::errc::bad_parameter);
+  CHECK(bad_method.error().message().find("method") != std::string::npos);
+}

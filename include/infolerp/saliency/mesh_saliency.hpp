@@ -22,9 +22,19 @@
 //      with a strict comparison, two computations that agree to 1e-14 gave saliencies 1% apart);
 //   3. N(S_i) = scaled S_i · (M − m̄)².
 //
-// The ball sums G are exact to rounding, every vertex pair within 2σ_max evaluated once with
-// vector code, with identical bits for any executor and thread count:
-// saliency/detail/gaussian_ball_averages.hpp.
+// The ball sums G are computed one of two ways (saliency_method), both with identical bits for any
+// executor and thread count:
+//   exact: exact to rounding, every vertex pair within 2σ_max evaluated once with vector code
+//     (saliency/detail/gaussian_ball_averages.hpp). Its cost grows with the pairs: on one surface,
+//     4x the vertices give 16x the pairs, since σ is a fraction of the bounding box.
+//   proxy: the same sums over one proxy per σ, the vertices grouped into cells of edge
+//     σ / proxy_cells_per_sigma (saliency/detail/proxy_ball_averages.hpp). Its cost per vertex
+//     does not grow with the resolution; its error falls as proxy_cells_per_sigma grows. It is
+//     judged by what saliency decides (which vertices are the 10% most salient, the LOD built on
+//     it), not by its L2 distance to exact: the hard 2σ edge of the kernel gives exact saliency
+//     vertex-scale structure no smooth approximation reproduces (benchmarks/NOTES.md,
+//     infolerp_pareto saliency).
+//   automatic (the default): exact below exact_below referenced vertices, proxy from there on.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -40,14 +50,21 @@
 #include "infolerp/mesh/geometry.hpp"
 #include "infolerp/mesh/topology.hpp"
 #include "infolerp/saliency/detail/gaussian_ball_averages.hpp"
+#include "infolerp/saliency/detail/proxy_ball_averages.hpp"
 
 namespace infolerp {
+
+// How the ball sums are computed (see the top of the file).
+enum class saliency_method { automatic, exact, proxy };
 
 struct saliency_options {
   double epsilon = 0.003;                          // ε as a fraction of the bounding-box diagonal
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
   double flat_level_threshold = 1e-3;              // levels below this × mean|C| are not stretched to [0,1]
   std::size_t grain = 1;                           // tiles of 3 × 3 columns per parallel task
+  saliency_method method = saliency_method::automatic;
+  std::size_t exact_below = 200000;                // automatic: exact below this many referenced vertices
+  double proxy_cells_per_sigma = 4.0;              // proxy: cells per σ along an axis (accuracy against time)
 };
 
 struct mesh_saliency {
@@ -55,19 +72,23 @@ struct mesh_saliency {
   std::vector<double> curvature;  // per vertex signed mean curvature (the C that was filtered)
   std::vector<std::vector<double>> levels;  // per scale i, per vertex: S_i before normalisation
   double epsilon = 0.0;           // ε in mesh units
+  saliency_method method = saliency_method::exact;  // the one used (never automatic)
 };
 
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
-// Errors: empty mesh, index out of range, non-finite position; epsilon <= 0 or not finite, no
-// scales or more than 16 (counted as given, repeats included), a scale <= 0 or not finite,
-// flat_level_threshold negative or not finite, a σ
-// (scale × epsilon × diagonal) below ~1.5e-154 or above ~3.3e153, where σ² underflows or 16σ²
-// overflows (bad_parameter); a
-// mesh whose bounding box has zero diagonal (degenerate_triangle).
-// Complexity: O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the unordered
-// pairs within 2σ_max, each evaluated once). Allocation O(V·σs) (3 doubles per vertex and
-// distinct σ, 64 at most; never per pair). Parallel through exec (6 phases of tiles); the
-// result is identical for every executor and thread count.
+// Errors: empty mesh, index out of range, non-finite position; method not one of the three,
+// epsilon <= 0 or not finite, no scales or more than 16 (counted as given, repeats included), a
+// scale <= 0 or not finite, flat_level_threshold negative or not finite, proxy_cells_per_sigma
+// not positive and finite or (proxy) so large that the finest proxy grid would need 2^21 cells
+// along the bounding-box diagonal, a σ (scale × epsilon × diagonal) below ~1.5e-154 or above
+// ~3.3e153, where σ² underflows or 16σ² overflows (bad_parameter); a mesh whose bounding box has
+// zero diagonal (degenerate_triangle).
+// Complexity: exact O(V log V + T + candidate pairs · distinct σs) (candidates: ~1.3× the
+// unordered pairs within 2σ_max, each evaluated once); proxy O(V log V + T + σs · (V + proxy
+// pairs)), the proxy pairs about (4·proxy_cells_per_sigma)² per proxy point.
+// Allocation O(V·σs) (exact: 3 doubles per vertex and distinct σ, 64 at most; proxy: about 6
+// more per vertex and σ; never per pair). Parallel through exec; the result is identical for
+// every executor and thread count.
 template <class M, class E = serial_executor>
 result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt = {}, E&& exec = E{}) {
   static_assert(check_mesh<M>());
@@ -84,6 +105,13 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
+  if (opt.method != saliency_method::automatic && opt.method != saliency_method::exact &&
+      opt.method != saliency_method::proxy)
+    return make_error(errc::bad_parameter, no_element, "saliency method ", static_cast<int>(opt.method),
+                      " is not automatic, exact or proxy");
+  if (!(opt.proxy_cells_per_sigma > 0.0) || !std::isfinite(opt.proxy_cells_per_sigma))
+    return make_error(errc::bad_parameter, no_element, "saliency proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
+                      " must be positive and finite");
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
@@ -120,14 +148,23 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   const std::vector<char> used = detail::referenced_vertices(m);
   const detail::vertex_points grid = detail::referenced_points(m, used, out.curvature);
   const std::size_t P = grid.x.size();
-  const std::vector<double> avg = detail::exact_gaussian_averages(exec, grid, sigma, opt.grain);
+  out.method = opt.method == saliency_method::automatic
+                   ? (P < opt.exact_below ? saliency_method::exact : saliency_method::proxy)
+                   : opt.method;
+  if (out.method == saliency_method::proxy &&
+      !(box.diagonal() * opt.proxy_cells_per_sigma / sigma[0] < detail::proxy_max_cells))
+    return make_error(errc::bad_parameter, no_element, "saliency proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
+                      " makes proxy cells of ", sigma[0] / opt.proxy_cells_per_sigma, ", more than ",
+                      detail::proxy_max_cells, " along the bounding-box diagonal ", box.diagonal());
+  const std::vector<double> avg =
+      out.method == saliency_method::exact
+          ? detail::exact_gaussian_averages(exec, grid, sigma, opt.grain)
+          : detail::proxy_gaussian_averages(exec, grid, sigma, opt.proxy_cells_per_sigma, opt.grain);
 
   // Levels and Lee's normalisation.
   double mean_abs_c = 0.0;
   for (std::size_t k = 0; k < P; ++k) mean_abs_c += std::abs(grid.value[k]);
   mean_abs_c /= static_cast<double>(P);
-  auto topo = make_topology(m);
-  if (!topo.ok()) return topo.error();
   out.saliency.assign(nv, 0.0);
   out.levels.assign(opt.scales.size(), std::vector<double>(nv, 0.0));
   std::vector<char> is_max(nv);
@@ -149,9 +186,16 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
       if (used[v] && global == nv && s[v] == mx) global = v;
     }
     const double tie = 1e-12 * mx;  // differences below this are rounding, not structure
-    for (const glm::uvec2& e : topo->edges) {
-      if (s[e.x] <= s[e.y] + tie) is_max[e.x] = 0;
-      if (s[e.y] <= s[e.x] + tie) is_max[e.y] = 0;
+    // The triangles' edges (an edge shared by two triangles is met twice, which changes nothing;
+    // the (a, a) side of a degenerate triangle is no edge).
+    for (std::size_t t = 0; t < mesh_triangle_count(m); ++t) {
+      const glm::uvec3 tri = mesh_triangle(m, t);
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
+        if (a == b) continue;
+        if (s[a] <= s[b] + tie) is_max[a] = 0;
+        if (s[b] <= s[a] + tie) is_max[b] = 0;
+      }
     }
     double sum_max = 0.0;
     std::size_t count_max = 0;

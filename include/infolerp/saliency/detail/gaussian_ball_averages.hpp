@@ -199,13 +199,16 @@ inline double* point_sums(double* sums, std::size_t L, std::size_t j, std::size_
 // the caller runs tiles whose write sets are disjoint concurrently, in a fixed order otherwise.
 // LC >= the number of σ: the σ loop is unrolled (8 at a time) so that, with LC = 8, i's sums
 // stay in registers (AVX-512: 16 of its 32).
-template <class V, std::size_t LC>
+// Weighted: points carry a weight row (column_grid::weighted); a pair adds weight · kernel to the
+// denominators and the value row (already the weighted value) · kernel to the numerators.
+template <class V, std::size_t LC, bool Weighted>
 INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                           column_tile tile, double* sums) {
   constexpr std::size_t width = sizeof(V) / sizeof(double), G = block_lanes / width;  // G vectors per block
   const std::size_t L = t.r2.size();
   const double r2max = t.r2[L - 1];
   const double *px_all = g.row(0), *py_all = g.row(1), *pz_all = g.row(2), *pc_all = g.row(3);
+  const double* pw_all = Weighted ? g.row(4) : nullptr;
   std::vector<column_ref> nearby;
   for (std::uint32_t tc = 0; tc < tile.count; ++tc) {
     const std::uint32_t own = tile.cols[tc];
@@ -213,6 +216,7 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
                   nearby);
       for (std::size_t i = g.col_start[own]; i < g.col_start[own + 1]; ++i) {
         const double xi = px_all[i], yi = py_all[i], zi = pz_all[i], ci = pc_all[i];
+        const double wi = Weighted ? pw_all[i] : 1.0;
         V acc_n[LC][G] = {}, acc_d[LC][G] = {}, w[LC][G];  // index s: σ number L − 1 − s
         for (const column_ref& nb : nearby) {
             const std::size_t q = nb.q;
@@ -230,11 +234,12 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
             // Blocks start at multiples of 8, so that j's sums are whole aligned vectors.
             for (std::size_t j = j0 / block_lanes * block_lanes; j < j1; j += block_lanes) {
               const bool partial = j < j0 || j + block_lanes > j1;
-              V d2[G], c[G];
+              V d2[G], c[G], wt[G];
               for (std::size_t k = 0; k < G; ++k) {
                 const std::size_t o = j + k * width;
                 V vx, vy, vz;
                 load_lanes(vx, px_all + o), load_lanes(vy, py_all + o), load_lanes(vz, pz_all + o), load_lanes(c[k], pc_all + o);
+                if constexpr (Weighted) load_lanes(wt[k], pw_all + o);
                 const V dx = vx - xi, dy = vy - yi, dz = vz - zi;
                 d2[k] = dx * dx + dy * dy + dz * dz;
                 if (partial) {  // lanes outside [j0, j1) (other points, or the rows' padding) get d² = +Inf
@@ -268,8 +273,14 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
                   V m;
                   keep(m, d2[k] <= t.r2[u], w[s][k]);
                   acc_n[s][k] = acc_n[s][k] + m * c[k];
-                  acc_d[s][k] = acc_d[s][k] + m;
-                  md[k] = m, mn[k] = m * ci;
+                  if constexpr (Weighted) {
+                    acc_d[s][k] = acc_d[s][k] + m * wt[k];
+                    md[k] = m * wi;
+                  } else {
+                    acc_d[s][k] = acc_d[s][k] + m;
+                    md[k] = m;
+                  }
+                  mn[k] = m * ci;
                 }
                 double* nj = point_sums(sums, L, j, u);
                 double* dj = nj + block_lanes;
@@ -296,19 +307,23 @@ INFOLERP_FORCE_INLINE void gather_tile(const column_grid& g, const sigma_table& 
           for (std::size_t h = block_lanes / 2; h > 0; h /= 2)  // pairwise, in a fixed order
             for (std::size_t l = 0; l < h; ++l) n[l] += n[l + h], d[l] += d[l + h];
           double* ni = point_sums(sums, L, i, L - 1 - s);
-          ni[0] += n[0] + ci;  // i itself: weight 1
-          ni[block_lanes] += d[0] + 1.0;
+          ni[0] += n[0] + ci;  // i itself: kernel 1
+          ni[block_lanes] += d[0] + wi;
         }
       }
   }
 }
 
-// One tile with vectors V, 8 or 32 σ slots.
+// One tile with vectors V, 8 or 32 σ slots, weighted or not.
 template <class V>
 INFOLERP_FORCE_INLINE void gather_tile_any(const column_grid& g, const sigma_table& t, std::uint32_t span,
                                               column_tile tile, double* sums) {
-  if (t.r2.size() <= 8) return gather_tile<V, 8>(g, t, span, tile, sums);
-  gather_tile<V, 32>(g, t, span, tile, sums);
+  if (g.weighted) {
+    if (t.r2.size() <= 8) return gather_tile<V, 8, true>(g, t, span, tile, sums);
+    return gather_tile<V, 32, true>(g, t, span, tile, sums);
+  }
+  if (t.r2.size() <= 8) return gather_tile<V, 8, false>(g, t, span, tile, sums);
+  gather_tile<V, 32, false>(g, t, span, tile, sums);
 }
 
 inline void gather_tile_portable(const column_grid& g, const sigma_table& t, std::uint32_t span, column_tile tile,
@@ -339,18 +354,19 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
 #endif
 
 // Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
-// points. Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
+// points (weighted ones too, vertex_points::weight), in columns 2σ_max / columns_per_ball wide.
+// Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
 // tiles of span × span columns in 6 phases by (tile x mod 2, tile y mod 3): the tiles of one
 // phase write disjoint points, so they run in parallel, and every point receives its terms in
 // an order fixed by the data: identical bits for any executor, thread count and grain (tiles
 // per task).
 template <class E>
 std::vector<double> exact_gaussian_averages(E& exec, const vertex_points& pg, const std::vector<double>& sigma,
-                                            std::size_t grain) {
+                                            std::size_t grain, double columns_per_ball = 3.0) {
   const std::size_t P = pg.x.size(), L = sigma.size();
   const sigma_table t = make_sigma_table(sigma);
   const double rmax = 2.0 * sigma[L - 1];
-  const column_grid g = make_column_grid(exec, pg, rmax / 3.0);
+  const column_grid g = make_column_grid(exec, pg, rmax / columns_per_ball);
   const auto span = static_cast<std::uint32_t>(std::ceil(rmax / g.h));
   const std::size_t stride = g.stride;
   std::vector<double> storage(2 * L * stride + block_lanes, 0.0);  // see point_sums

@@ -17,9 +17,11 @@
 
 namespace infolerp::detail {
 
-// The referenced vertices (those a triangle uses), in index order: position, value, index.
+// The referenced vertices (those a triangle uses), in index order: position, value, index; or
+// weighted points (a proxy's cells: value = the sum of the values it stands for, weight = their
+// count). An empty weight means weight 1 everywhere.
 struct vertex_points {
-  std::vector<double> x, y, z, value;
+  std::vector<double> x, y, z, value, weight;
   std::vector<std::uint32_t> id;
 };
 
@@ -63,13 +65,14 @@ inline std::size_t aligned_offset(const std::vector<double>& v) {
 // only occupied columns are stored, ordered by (cx, cy), so memory and time follow the points,
 // not the bounding box (one far vertex leaves the other columns as fine as without it).
 struct column_grid {
-  std::vector<double> rows;               // sorted points: x, y, z, value rows (see row)
+  std::vector<double> rows;               // sorted points: x, y, z, value (, weight) rows (see row)
+  bool weighted = false;                  // a weight row follows the value row
   std::size_t points = 0, stride = 0, offset = 0;
   std::vector<std::uint32_t> src;         // index of each sorted point in the source vertex_points
   std::vector<std::uint64_t> col_key;     // occupied columns, ascending: cx << 32 | cy
   std::vector<std::uint32_t> col_start;   // occupied columns + 1 offsets into the sorted points
   double x0 = 0.0, y0 = 0.0, h = 1.0;     // grid origin and column width
-  // Row r (0 x, 1 y, 2 z, 3 value), 64-byte aligned (unless the grid was copied).
+  // Row r (0 x, 1 y, 2 z, 3 value, 4 weight when weighted), 64-byte aligned (unless the grid was copied).
   const double* row(std::size_t r) const { return rows.data() + offset + r * stride; }
   static std::uint64_t key(std::uint32_t cx, std::uint32_t cy) { return std::uint64_t{cx} << 32 | cy; }
   // Index of column (cx, cy) among the occupied ones, or col_key.size() when it is empty.
@@ -116,12 +119,14 @@ column_grid make_column_grid(E& exec, const vertex_points& g, double width) {
       });
   });
   c.points = P, c.stride = block_stride(P);
-  c.rows.assign(4 * c.stride + block_lanes, 0.0);
+  c.weighted = !g.weight.empty();
+  c.rows.assign((c.weighted ? 5 : 4) * c.stride + block_lanes, 0.0);
   c.offset = aligned_offset(c.rows);
   double* r = c.rows.data() + c.offset;
   for (std::size_t k = 0; k < P; ++k) {
     const std::uint32_t s = order[k];
     r[k] = g.x[s], r[c.stride + k] = g.y[s], r[2 * c.stride + k] = g.z[s], r[3 * c.stride + k] = g.value[s];
+    if (c.weighted) r[4 * c.stride + k] = g.weight[s];
   }
   c.src = std::move(order);
   return c;
