@@ -12,11 +12,9 @@
 // 20 bytes per vertex plus 40 per hierarchy triangle. With max_cached_samples, vertices outside
 // the view are evicted least recently visible first; the current view's are never evicted, and
 // refinement stops (cache_full) once they alone reach the bound.
-// Hierarchy: with max_hierarchy_triangles, a new view that finds more triangles in use prunes
-// (subdivision_mesh::coarsen) subtrees outside the view, least recently in view first, down to
-// bound − bound/8: only subtrees none of whose triangles is in view, shown or awaiting a delta
-// and none of whose created vertices is cached or requested, so nothing the view shows changes.
-// Freed ids are reused by later splits. The current view's triangles are never pruned.
+// Hierarchy: with max_hierarchy_triangles, a new view prunes (subdivision_mesh::coarsen) subtrees
+// none of whose triangles is in view, shown or awaiting a delta and none of whose vertices is
+// cached or requested, least recently in view first, down to bound − bound/8; ids are reused.
 // Shading: each vertex of a shown leaf and of its ancestors is requested once; take_requests()
 // hands out shading_points, deliver() takes colours for any subset in any order, from any thread
 // or machine (calls on one refiner must not overlap). shade_requests() is the synchronous adaptor.
@@ -32,13 +30,10 @@
 // until the criterion selects nothing, the budget is reached (checked per batch) or max_batches
 // ran. Δ: triangles shown now; Δ_total: triangles sent to the visualizer since the view was set
 // (those that entered the shown set; a new view sends only what the previous one did not show).
-// Work: each pixel is listed under its leaf, so a batch touches the pixels of the leaves it split,
-// never the whole image, the whole visible set or the hierarchy outside the view: the split leaves
-// are found from the triangles the batch created, NLD_OS's candidates wait in a heap the splits
-// update (nld_os_queue.hpp), the visible and shown sets change in O(1) per member and deltas are
-// built from the members that changed; the shown cut is recomputed only under what a batch split
-// or a delivery made ready; the luminance image and L_max follow the leaves whose shown triangle
-// changed. A new view is O(pixels).
+// Work: a batch touches the pixels of the leaves it split (each pixel is listed under its leaf),
+// never the whole image, visible set or hierarchy: NLD_OS's candidates wait in a heap the splits
+// update (nld_os_queue.hpp), sets change in O(1) per member, deltas, the shown cut, the luminance
+// image and L_max follow what a batch split or a delivery made ready. A new view is O(pixels).
 //
 // The tracer models infolerp::tracer with the mesh's triangle ids; the synchronous callback
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
