@@ -47,6 +47,7 @@
 #include "infolerp/refine/nld.hpp"
 #include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/pinhole_camera.hpp"
+#include "infolerp/refine/refiner_types.hpp"
 #include "infolerp/refine/subdivision_mesh.hpp"
 #include "infolerp/lod/weighting_map.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
