@@ -24,6 +24,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/refine/pinhole_camera.hpp"
 #include "infolerp/upsample/ray_cast_source.hpp"
 #include "infolerp/upsample/sample_source.hpp"
 #include "support/demo_scene.hpp"
@@ -253,6 +254,22 @@ result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_s
   return demo_ray_cast_source<Probes>::create(scene.tracer, demo_camera{shader.camera_rays(), width, height},
                                               demo_geometry{&scene}, demo_material{&shader, &clusters}, std::move(ids),
                                               std::move(o));
+}
+
+// The pinhole frame (refine/pinhole_camera.hpp) of camera c for a width x height image: the
+// same rays as c.rays(), and the projection frame_reuse.hpp reprojects with.
+inline pinhole_frame pinhole_frame_of(const camera& c, std::uint32_t width, std::uint32_t height) {
+  const pinhole_rays r = c.rays();
+  pinhole_frame f;
+  f.eye = r.eye;
+  f.forward = r.forward;
+  f.right = r.right;
+  f.up = r.true_up;
+  f.tan_half_fov = r.half_h;
+  f.aspect = static_cast<float>(width) / static_cast<float>(height);
+  f.width = width;
+  f.height = height;
+  return f;
 }
 
 // Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.
