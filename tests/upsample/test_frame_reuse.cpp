@@ -6,6 +6,7 @@
 // same without invalidation does (the check can fail).
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -17,6 +18,12 @@
 #include "support/demo_clusters.hpp"
 #include "support/demo_upsample.hpp"
 #include "support/thread_pool.hpp"
+
+// The counter of support/allocation_counter.hpp, which test_upsampler.cpp includes for this
+// executable (it replaces operator new, so only one file may include it).
+namespace infolerp::support {
+inline std::atomic<std::size_t> heap_allocations{0};
+}
 
 namespace support = infolerp::support;
 using infolerp::probe_mode;
@@ -330,4 +337,27 @@ TEST_CASE("frame reuse: a moved object invalidated by the user never shows stale
   };
   CHECK(stale_error(true) == 0.0f);  // the camera stands still: what is not stale is the fresh frame's own
   CHECK(stale_error(false) > 0.5f);  // without invalidation the old shadow shows
+}
+
+TEST_CASE("frame reuse: warm frames along a path allocate nothing", "[upsample][frame_reuse]") {
+  const sphere_scene sc{};
+  auto up = infolerp::upsampler<asample>::create(W, H, {.passes = 3, .max_passes = 3, .keep_ibuffer = true});
+  REQUIRE(up);
+  auto reuse = infolerp::frame_reuse<asample>::create(W, H);
+  REQUIRE(reuse);
+  std::vector<float> out(std::size_t{W} * H);
+  infolerp::pinhole_camera cam{.eye = {0.0f, -6.0f, 4.0f}, .target = {0.5f, 0.5f, 0.0f}, .up = {0.0f, 0.0f, 1.0f},
+                               .vertical_fov_degrees = 50.0f, .width = W, .height = H};
+  REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+  const std::size_t before = support::heap_allocations.load();
+  std::size_t reused = 0;
+  for (int f = 1; f <= 4; ++f) {
+    cam.eye.x += 0.02f;
+    REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+    reused += reuse->stats().reused;
+  }
+  CHECK(support::heap_allocations.load() == before);
+  CHECK(reused > 0);
+  const std::vector<int> probe_counter(4);  // the counter sees this file's allocations
+  CHECK(support::heap_allocations.load() > before);
 }
