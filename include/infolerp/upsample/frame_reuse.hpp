@@ -4,7 +4,7 @@
 // caches shading across views; this does both). frame_reuse wraps the engine's probing sample
 // source (sample_source.hpp) for one upsampler frame: where the upsampler asks for a full
 // evaluation, the wrapper probes the pixel (primary hit: position, cluster id, normal, and the
-// light bits when the probe carries them), reprojects the hit into the previous frame's
+// light bits: a refining source's probe is refined), reprojects the hit into the previous frame's
 // pinhole view and, when the previous frame's samples there pass §4's test against the probe
 // (probe_compatible / compatible: same cluster id and light bits; agree() pairwise; and the
 // view depth within depth_tolerance, which rejects disocclusions inside one cluster), completes
@@ -112,6 +112,9 @@ class reusing_source {
     if constexpr (detail::has_background_flag<S>) {
       if (p.background()) return p;
     }
+    // A probe that leaves out part of compatible() (refine_probe) is completed first: a kept
+    // sample's light bits are never taken across a hard-shadow edge.
+    if constexpr (refining_sample_source<Source>) p = inner_->refine_probe(p, x, y);
     bool identity = false;
     S out;
     if (!reuse(p, out, identity)) return full(x, y, reuse_mark::evaluated);
@@ -209,7 +212,11 @@ class reusing_source {
   bool serves(const S& p, std::size_t i, double z) const {
     if (!h_.valid[i]) return false;
     const S& s = h_.samples[i];
-    if (!detail::may_complete(*this, p, s)) return false;
+    if constexpr (refining_sample_source<Source>) {
+      if (!detail::may_interpolate(*this, p, s)) return false;
+    } else {
+      if (!detail::may_complete(*this, p, s)) return false;
+    }
     const double depth = glm::dot(glm::dvec3(s.position) - glm::dvec3(h_.view->eye), glm::dvec3(h_.view->forward));
     return std::abs(depth - z) <= double(h_.options.depth_tolerance) * z;
   }
