@@ -74,12 +74,12 @@ infolerp::upsampler<sample> make_upsampler() {
   return std::move(*up);
 }
 
-// Calls f(source, view) with the ready source (primary probes) seeing the scene through camera c.
-template <class F>
+// Calls f(source, view) with the ready source (primary probes unless told) seeing the scene through camera c.
+template <probe_mode Mode = probe_mode::primary, class F>
 void with_view(const support::camera& c, const F& f) {
   scene().view = c;
   const support::reference_shader shader(scene(), {.ao_rays = 8, .soft_shadow_rays = 4});
-  auto src = support::make_demo_ray_cast_source<probe_mode::primary>(shader, clusters(), int(W), int(H));
+  auto src = support::make_demo_ray_cast_source<Mode>(shader, clusters(), int(W), int(H));
   REQUIRE(src);
   f(*src, support::pinhole_frame_of(c, W, H));
   scene().view = base_camera();
@@ -176,6 +176,35 @@ TEST_CASE("frame reuse: a small move stays close to the fresh frame; a camera cu
   CHECK(reuse->stats().reused == 0);
   CHECK(same_frame(after_cut, fresh(cut, &fresh_evaluated)));
   CHECK(up.stats().evaluated() == fresh_evaluated);
+}
+
+TEST_CASE("frame reuse: with refined probes where sources differ, fresh after invalidate() and repeated when standing",
+          "[upsample][frame_reuse]") {
+  const infolerp::upsampler_options sparse{.passes = 4, .max_passes = 4, .keep_ibuffer = true, .min_sources = 1,
+                                           .probe_every_sample = false};
+  auto up = infolerp::upsampler<sample>::create(W, H, sparse);
+  auto plain = infolerp::upsampler<sample>::create(W, H, sparse);
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE((up && plain && reuse));
+  std::vector<glm::vec3> out(std::size_t{W} * H), fresh_out(out.size()), first(out.size());
+  const auto frame = [&](const support::camera& c) {
+    with_view<probe_mode::refine>(c, [&](const auto& src, const infolerp::pinhole_frame& view) {
+      REQUIRE(reuse->render(*up, src, view, std::span<glm::vec3>(out)));
+      REQUIRE(plain->render(src, std::span<glm::vec3>(fresh_out)));
+    });
+  };
+  frame(base_camera());
+  CHECK(same_frame(out, fresh_out));
+  first = out;
+  frame(base_camera());
+  CHECK(same_frame(out, first));
+  CHECK(reuse->stats().evaluated == 0);
+  frame(moved(0.05f));
+  CHECK(reuse->stats().reused > 0);
+  CHECK(psnr(out, fresh_out) > 35.0);
+  reuse->invalidate();
+  frame(moved(0.05f));
+  CHECK(same_frame(out, fresh_out));
 }
 
 TEST_CASE("frame reuse: every executor gives the same frames", "[upsample][frame_reuse]") {

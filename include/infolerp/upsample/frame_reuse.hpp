@@ -48,7 +48,7 @@ namespace infolerp {
 
 struct frame_reuse_options {
   float depth_tolerance = 0.02f;     // a kept sample serves when its view depth is within this share of the probe's
-  std::uint32_t refresh_period = 8;  // moving camera: about 1 in this many reusable samples is evaluated anew (0: never)
+  std::uint32_t refresh_period = 4;  // moving camera: about 1 in this many reusable samples is evaluated anew (0: never)
 };
 
 // What the last render() did, in pixels of the image (the cropped border is not counted).
