@@ -119,10 +119,11 @@ class path_harness {
     }
     return std::move(*src);
   }
-  infolerp::upsampler<sample> upsampler_for(const setting& s) const {
+  // keep: keep the I-Buffer (frame_reuse needs it; the per-frame I-Buffer does not pay for it).
+  infolerp::upsampler<sample> upsampler_for(const setting& s, bool keep = false) const {
     auto up = infolerp::upsampler<sample>::create(std::uint32_t(w_), std::uint32_t(h_),
                                                   {.passes = s.passes, .max_passes = s.passes, .record_kinds = false,
-                                                   .keep_ibuffer = true, .min_sources = 1,
+                                                   .keep_ibuffer = keep, .min_sources = 1,
                                                    .probe_every_sample = s.probe_every_sample});
     if (!up) {
       std::fprintf(stderr, "infolerp_pareto upsample --path: %s\n", up.error().message().c_str());
@@ -214,12 +215,12 @@ int write_plot(const std::string& csv, int w, int h) {
      << "set datafile separator ','\nset multiplot layout 2,1 title 'Demo scene " << w << "x" << h
      << " along a camera path (standing still in frames 50-69)'\n"
      << "set xlabel 'frame'\nset ylabel 'seconds (log)'\nset logscale y\nset grid\nset key outside right\n"
-     << "plot '" << csv << "' using 1:(stringcolumn(2) eq 'per_pixel' ? $3 : 1/0) with lines title 'per_pixel', "
-     << "'' using 1:(stringcolumn(2) eq 'ibuffer' ? $3 : 1/0) with lines title 'ibuffer', "
-     << "'' using 1:(stringcolumn(2) eq 'ibuffer_reuse' ? $3 : 1/0) with lines title 'ibuffer_reuse'\n"
+     << "plot '" << csv << "' using 1:(stringcolumn(2) eq 'per_pixel' ? $3 : 1/0) with points pt 7 ps 0.4 title 'per_pixel', "
+     << "'' using 1:(stringcolumn(2) eq 'ibuffer' ? $3 : 1/0) with points pt 7 ps 0.4 title 'ibuffer', "
+     << "'' using 1:(stringcolumn(2) eq 'ibuffer_reuse' ? $3 : 1/0) with points pt 7 ps 0.4 title 'ibuffer_reuse'\n"
      << "unset logscale y\nset ylabel 'PSNR dB vs per_pixel'\n"
-     << "plot '" << csv << "' using 1:(stringcolumn(2) eq 'ibuffer' ? $4 : 1/0) with lines title 'ibuffer', "
-     << "'' using 1:(stringcolumn(2) eq 'ibuffer_reuse' ? $4 : 1/0) with lines title 'ibuffer_reuse', 40 with lines dt 2 title '40 dB'\n"
+     << "plot '" << csv << "' using 1:(stringcolumn(2) eq 'ibuffer' ? $4 : 1/0) with points pt 7 ps 0.4 title 'ibuffer', "
+     << "'' using 1:(stringcolumn(2) eq 'ibuffer_reuse' ? $4 : 1/0) with points pt 7 ps 0.4 title 'ibuffer_reuse', 40 with lines dt 2 title '40 dB'\n"
      << "unset multiplot\n";
   gp.close();
   const std::string cmd = "gnuplot '" + base + ".gp'";
@@ -317,7 +318,7 @@ int pareto_upsample_path(int argc, char** argv) {
   auto up_plain = h.upsampler_for(s);
   setting rs = s;
   if (reuse_passes > 0) rs.passes = std::uint32_t(reuse_passes), rs.name += ", reuse with " + std::to_string(reuse_passes) + " passes";
-  auto up_reuse = h.upsampler_for(rs);
+  auto up_reuse = h.upsampler_for(rs, true);
   auto reuse = infolerp::frame_reuse<sample>::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
   if (!reuse) return std::fprintf(stderr, "%s\n", reuse.error().message().c_str()), 1;
   std::ofstream out(csv);
