@@ -1,31 +1,19 @@
 #pragma once
-// Frames along a camera path: the I-Buffer reuses what earlier frames shaded (beyond the
-// papers: the clustering paper's §4 interpolates within a frame, the refinement paper's §2
-// caches shading across views; this does both). frame_reuse wraps the engine's probing sample
-// source (sample_source.hpp) for one upsampler frame: where the upsampler asks for a full
-// evaluation, the wrapper probes the pixel (primary hit: position, cluster id, normal, and the
-// light bits: a refining source's probe is refined), reprojects the hit into the previous frame's
-// pinhole view and, when the previous frame's samples there pass §4's test against the probe
-// (probe_compatible / compatible: same cluster id and light bits; agree() pairwise; and the
-// view depth within depth_tolerance, which rejects disocclusions inside one cluster), completes
-// the probe with their expensive terms (AO, soft shadows) through the source's
-// interpolate(probe, ...). Everything the probe gives (position, normal, texcoords) and shade()
-// are new every frame, so view-dependent terms are always re-shaded. Otherwise, and in
-// disocclusions, the wrapped source evaluates.
-// Sources: the previous frame's pixels nearest the reprojected point, quantised to quarter
-// pixels: one pixel (within 1/4 of its centre on both axes), the two of an edge or the four
-// around it; a kept sample at the probe's very position is taken whole, so a camera standing
-// still repeats its frame bit for bit. A moving camera
-// resamples earlier interpolations; options.refresh_period re-evaluates a fixed, hashed share of
-// the reused samples each frame so that resampling does not drift (benchmarks/NOTES.md).
-// Invalidation: invalidate() forgets everything (the next frame is a fresh frame, bit for bit);
-// invalidate_if(pred) forgets the kept samples pred accepts (e.g. those within reach of a moved
-// object or in its shadow). Lights that change change occlusion anywhere: invalidate().
-// Preconditions: the source's camera is the pinhole_frame given to render(); sample_type has a
-// world-space `position`; a probe that hits nothing (background()) is that pixel's full sample.
-// Allocation: create() allocates the history (W·H samples) and two byte planes; render()
-// allocates nothing. Deterministic for every executor (decisions depend on the pixel, the
-// frame number and the previous frame only).
+// Frames along a camera path: the I-Buffer reuses what the previous frame shaded (beyond the
+// papers: the clustering paper's §4 within a frame, the refinement paper's §2 across views).
+// Where the upsampler asks for a full evaluation, the wrapped source's probe (refined when the
+// source refines) is reprojected into the previous pinhole view; the kept samples there (the
+// nearest pixel within 1/4 of its centre, else the pair or the four around it) that pass §4's
+// test against it (compatible, agree(), view depth within depth_tolerance) give it their
+// expensive terms through interpolate(probe, ...); else the source evaluates. Position, normal,
+// texcoords and shade() are new every frame. A kept sample at the probe's very position is taken
+// whole (a camera standing still repeats its frame bit for bit); refresh_period re-evaluates a
+// hashed share of the moved ones so that resampling does not drift (benchmarks/NOTES.md).
+// invalidate(): the next frame is a fresh one, bit for bit (scene, lights or ids changed);
+// invalidate_if(pred): an object changed (pred names the kept samples it touches).
+// Preconditions: the source's camera is render()'s pinhole_frame; sample_type has a world
+// `position`; a background probe is that pixel's full sample. Allocation: create() only.
+// Same output for every executor.
 #include <algorithm>
 #include <array>
 #include <cmath>
