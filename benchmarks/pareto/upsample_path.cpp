@@ -1,5 +1,5 @@
 // infolerp_pareto upsample --path --csv FILE [--size W H] [--frames N] [--threads N] [--ao N] [--soft N]
-//                          [--settings LIST] [--pictures DIR]
+//                          [--pictures DIR] [--reuse-passes P] [--refresh K] [--depth-tolerance T]
 //
 // Frames along a camera path through the built-in demo scene (reference shading: AO 64 rays,
 // soft shadow 16 rays, hard-shadow sun; feature clusters at the demo's thresholds), every frame
@@ -19,7 +19,8 @@
 // cropped border; frame_reuse's for ibuffer_reuse); reused_fraction: evaluations served from
 // the previous frame). FILE.png: time and PSNR per frame (gnuplot; FILE.gp next to it).
 // Printed: sums over the path and the goals. --pictures DIR writes path.png there: a
-// strip of every 15th frame with reuse, its evaluated pixels marked red.
+// strip of every 15th frame with reuse, its evaluated pixels marked red. --reuse-passes,
+// --refresh and --depth-tolerance change the reuse row's passes and frame_reuse_options.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -249,7 +250,8 @@ int pareto_upsample_path(int argc, char** argv) {
     else if (a == "--refresh" && i + 1 < argc) reuse_options.refresh_period = std::uint32_t(std::atoi(argv[++i]));
     else if (a == "--depth-tolerance" && i + 1 < argc) reuse_options.depth_tolerance = std::strtof(argv[++i], nullptr);
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto upsample --path --csv FILE [--size W H] [--frames N] [--threads N] [--ao N] [--soft N] [--pictures DIR]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto upsample --path --csv FILE [--size W H] [--frames N] [--threads N] [--ao N] "
+                           "[--soft N] [--pictures DIR] [--reuse-passes P] [--refresh K] [--depth-tolerance T]\n");
       return 2;
     }
   }
