@@ -10,6 +10,7 @@
 [[gnu::weak]] int pareto_refine(int argc, char** argv);
 [[gnu::weak]] int pareto_upsample(int argc, char** argv);
 [[gnu::weak]] int pareto_upsample_textured(int argc, char** argv);  // upsample --textured DIR
+[[gnu::weak]] int pareto_upsample_path(int argc, char** argv);      // upsample --path
 [[gnu::weak]] int pareto_walk(int argc, char** argv);
 [[gnu::weak]] int pareto_lod(int argc, char** argv);
 [[gnu::weak]] int pareto_visibility(int argc, char** argv);

@@ -1,6 +1,7 @@
 // infolerp_pareto upsample (--csv FILE | --diagnose) [--only METHOD,...] [--match TEXT] [--repeat N]
 //                          [--size W H] [--threads N] [--ao N] [--soft N] [--tessellate SHARE]
 // infolerp_pareto upsample --textured DIR ...   (a textured asset from disk: upsample_textured.cpp)
+// infolerp_pareto upsample --path ...           (frames along a camera path, with reuse: upsample_path.cpp)
 //
 // Time against error of the I-Buffer upsampler and its competitors on the demo scene
 // (1025x1025 by default) with the reference shader (AO 64 rays, soft shadow 16 rays, hard-shadow
@@ -811,6 +812,8 @@ bool parse_int(const char* text, int lo, int hi, int& out) {
 int pareto_upsample(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)  // the textured-asset mode (upsample_textured.cpp)
     if (std::string_view(argv[i]) == "--textured" && pareto_upsample_textured != nullptr) return pareto_upsample_textured(argc, argv);
+  for (int i = 1; i < argc; ++i)  // frames along a camera path (upsample_path.cpp)
+    if (std::string_view(argv[i]) == "--path" && pareto_upsample_path != nullptr) return pareto_upsample_path(argc, argv);
   std::string csv;
   bool diagnose = false;
   std::string only, match;

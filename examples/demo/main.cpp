@@ -1,6 +1,7 @@
 // infolerp_demo: renders the built-in demo scene (plus any --mesh assets, textured) with the full
 // per-pixel reference shader (DIR/reference.png), then runs the stages on the same context:
-// saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), the
+// saliency (saliency.png), the I-Buffer upsampler (ibuffer.png, rie.png, error.png), frames
+// along a camera path with reuse across frames (path.png), the
 // view-dependent LOD of the mesh (lod.png) and the summary (a printed table, summary.csv,
 // tradeoff.png). Every stage prints its wall time ("time: STAGE  S s") and the run ends with
 // the list of stages, longest first; a stage past about 2 s shows progress on stderr. Any error
@@ -22,6 +23,7 @@
 #include "stage_saliency.hpp"
 #include "stage_summary.hpp"
 #include "stage_upsample.hpp"
+#include "stage_path.hpp"
 
 namespace demo = infolerp::demo;
 namespace support = infolerp::support;
@@ -237,6 +239,7 @@ int main(int argc, char** argv) {
   if (!demo::stage_clusters(ctx, clusters)) return 1;
   if (!demo::stage_saliency(ctx)) return 1;
   if (!demo::stage_upsample(ctx, &clusters)) return 1;
+  if (!demo::stage_path(ctx, clusters)) return 1;
   if (!demo::stage_lod(ctx)) return 1;
   if (!demo::stage_summary(ctx)) return 1;
   print_times(ctx, run.seconds());

@@ -16,6 +16,7 @@
 #include "infolerp/refine/progressive_driver.hpp"        // progressive refinement (NLD_OS, NLD_IS, RND)
 #include "infolerp/upsample/upsampler.hpp"               // the I-Buffer upsampler
 #include "infolerp/upsample/pass_controller.hpp"         // automatic pass count
+#include "infolerp/upsample/frame_reuse.hpp"             // reuse across the frames of a camera path
 #include "infolerp/cluster/uv_seams.hpp"                 // clusters cut at texture seams
 #include "infolerp/mesh/validate.hpp"                    // mesh checks
 #include "infolerp/mesh/locality_order.hpp"              // Morton order of triangles

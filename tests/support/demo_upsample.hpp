@@ -24,6 +24,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/mesh/geometry.hpp"
+#include "infolerp/refine/pinhole_camera.hpp"
 #include "infolerp/upsample/ray_cast_source.hpp"
 #include "infolerp/upsample/sample_source.hpp"
 #include "support/demo_scene.hpp"
@@ -227,12 +228,16 @@ template <probe_mode Probes = probe_mode::none>
 using demo_ray_cast_source = ray_cast_source<embree_scene, demo_camera, demo_geometry, demo_material, Probes>;
 
 // shader's options give the counts (AO rays, soft-shadow points, the sun when hard_shadow,
-// packets as batch_rays); clusters and shader must outlive the source.
+// packets as batch_rays); clusters and shader must outlive the source. `view`: the camera's
+// rays (default: the shader's, i.e. the scene's camera when the shader was made; another view
+// shades alike except an image texture's mip level, which reads the shader's eye).
 template <probe_mode Probes = probe_mode::none>
 result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_shader& shader, const scene_clustering& clusters,
                                                                int width, int height, bool perspective = true,
                                                                float tolerance = std::numeric_limits<float>::infinity(),
-                                                               float smooth_angle = ray_cast_options{}.smooth_angle) {
+                                                               float smooth_angle = ray_cast_options{}.smooth_angle,
+                                                               const pinhole_rays* view = nullptr) {
+  const pinhole_rays& rays = view != nullptr ? *view : shader.camera_rays();
   const demo_scene& scene = shader.scene();
   const shader_options& so = shader.options();
   ray_cast_options o{.ao_rays = so.ao_rays, .ao_radius = scene.ao_radius, .ray_offset = scene.ray_offset};
@@ -244,15 +249,31 @@ result<demo_ray_cast_source<Probes>> make_demo_ray_cast_source(const reference_s
   o.soft_normal = scene.area.normal();
   o.batch_rays = so.packets;
   if (perspective) {
-    o.view_origin = shader.camera_rays().eye;
-    o.view_forward = shader.camera_rays().forward;
+    o.view_origin = rays.eye;
+    o.view_forward = rays.forward;
   }
   o.tolerance = tolerance;
   o.smooth_angle = smooth_angle;
   std::vector<std::span<const std::uint32_t>> ids(clusters.ids.begin(), clusters.ids.end());
-  return demo_ray_cast_source<Probes>::create(scene.tracer, demo_camera{shader.camera_rays(), width, height},
+  return demo_ray_cast_source<Probes>::create(scene.tracer, demo_camera{rays, width, height},
                                               demo_geometry{&scene}, demo_material{&shader, &clusters}, std::move(ids),
                                               std::move(o));
+}
+
+// The pinhole frame (refine/pinhole_camera.hpp) of camera c for a width x height image: the
+// same rays as c.rays(), and the projection frame_reuse.hpp reprojects with.
+inline pinhole_frame pinhole_frame_of(const camera& c, std::uint32_t width, std::uint32_t height) {
+  const pinhole_rays r = c.rays();
+  pinhole_frame f;
+  f.eye = r.eye;
+  f.forward = r.forward;
+  f.right = r.right;
+  f.up = r.true_up;
+  f.tan_half_fov = r.half_h;
+  f.aspect = static_cast<float>(width) / static_cast<float>(height);
+  f.width = width;
+  f.height = height;
+  return f;
 }
 
 // Display luma (Rec. 709 weights on 8-bit sRGB values, in [0, 1]): what PSNR and SSIM look at.

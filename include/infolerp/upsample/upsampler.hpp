@@ -271,6 +271,16 @@ class upsampler {
   // The final I-Buffer of the last render (width·height samples, row-major); empty unless
   // options.keep_ibuffer.
   [[nodiscard]] std::span<const Sample> ibuffer() const noexcept { return levels_[0]; }
+  // Exchanges the kept final I-Buffer (keep_ibuffer) with `other`, which must hold width·height
+  // samples (else errc::bad_size, nothing exchanged): a caller that keeps frames takes the last
+  // one without copying it (frame_reuse.hpp). O(1), no allocation.
+  [[nodiscard]] status swap_ibuffer(std::vector<Sample>& other) {
+    if (!options_.keep_ibuffer || other.size() != levels_[0].size())
+      return make_error(errc::bad_size, no_element, "upsampler: swap_ibuffer needs keep_ibuffer and ", levels_[0].size(),
+                        " samples, got ", other.size());
+    levels_[0].swap(other);
+    return {};
+  }
   // R/I/E kind of each pixel in the last pass of the last render (empty unless record_kinds).
   [[nodiscard]] std::span<const sample_kind> kinds() const noexcept { return kinds_; }
   // Samples held by the pyramid (memory: this times sizeof(Sample)).

@@ -1,0 +1,392 @@
+// Reuse across frames (upsample/frame_reuse.hpp): on the demo scene through Embree with the
+// ready source, a fresh frame after invalidate(), a camera standing still and a camera cut
+// against the upsampler without reuse in the same run, bit for bit; every executor alike; a
+// small move close to the fresh frame; bad input named. On an analytic scene (a sphere's soft
+// shadow on a plane), a moved sphere invalidated by the user shows no stale shadow, and the
+// same without invalidation does (the check can fail).
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <span>
+#include <vector>
+#include "infolerp/upsample/frame_reuse.hpp"
+#include "infolerp/upsample/ray_cast_source.hpp"
+#include "infolerp/upsample/upsampler.hpp"
+#include "support/demo_clusters.hpp"
+#include "support/demo_upsample.hpp"
+#include "support/thread_pool.hpp"
+
+// The counter of support/allocation_counter.hpp, which test_upsampler.cpp includes for this
+// executable (it replaces operator new, so only one file may include it).
+namespace infolerp::support {
+inline std::atomic<std::size_t> heap_allocations{0};
+}
+
+namespace support = infolerp::support;
+using infolerp::probe_mode;
+using sample = support::demo_sample;
+
+namespace {
+
+constexpr std::uint32_t W = 96, H = 72;
+
+support::demo_scene& scene() {
+  static const support::embree_device device;
+  static support::demo_scene s = [] {
+    support::demo_scene_options small;
+    small.sphere_slices = 24;
+    small.sphere_stacks = 12;
+    small.torus_major = 24;
+    small.torus_minor = 8;
+    auto built = support::make_demo_scene(device, small);
+    REQUIRE(built.ok());
+    return std::move(*built);
+  }();
+  return s;
+}
+
+const support::scene_clustering& clusters() {
+  static const support::scene_clustering c = [] {
+    auto seams = support::split_at_texture_seams(scene(), support::cluster_by_normal(scene(), 2));
+    REQUIRE(seams);
+    return std::move(*seams);
+  }();
+  return c;
+}
+
+support::camera base_camera() {
+  static const support::camera c = scene().view;
+  return c;
+}
+
+support::camera moved(float dx, float dy = 0.0f) {
+  support::camera c = base_camera();
+  c.eye += glm::vec3(dx, dy, 0.0f);
+  return c;
+}
+
+infolerp::upsampler<sample> make_upsampler() {
+  auto up = infolerp::upsampler<sample>::create(W, H, {.passes = 3, .max_passes = 3, .keep_ibuffer = true});
+  REQUIRE(up);
+  return std::move(*up);
+}
+
+// Calls f(source, view) with the ready source (primary probes unless told) seeing the scene through camera c.
+template <probe_mode Mode = probe_mode::primary, class F>
+void with_view(const support::camera& c, const F& f) {
+  scene().view = c;
+  const support::reference_shader shader(scene(), {.ao_rays = 8, .soft_shadow_rays = 4});
+  auto src = support::make_demo_ray_cast_source<Mode>(shader, clusters(), int(W), int(H));
+  REQUIRE(src);
+  f(*src, support::pinhole_frame_of(c, W, H));
+  scene().view = base_camera();
+}
+
+bool same_frame(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+}
+
+// The frame through camera c without reuse, and the upsampler's evaluation count.
+std::vector<glm::vec3> fresh(const support::camera& c, std::size_t* evaluated = nullptr) {
+  std::vector<glm::vec3> out(std::size_t{W} * H);
+  auto up = make_upsampler();
+  with_view(c, [&](const auto& src, const infolerp::pinhole_frame&) { REQUIRE(up.render(src, std::span<glm::vec3>(out))); });
+  if (evaluated) *evaluated = up.stats().evaluated();
+  return out;
+}
+
+template <class E = infolerp::serial_executor>
+std::vector<glm::vec3> reuse_frame(infolerp::frame_reuse<sample>& reuse, infolerp::upsampler<sample>& up,
+                                   const support::camera& c, E exec = E{}) {
+  std::vector<glm::vec3> out(std::size_t{W} * H);
+  with_view(c, [&](const auto& src, const infolerp::pinhole_frame& view) {
+    REQUIRE(reuse.render(up, src, view, std::span<glm::vec3>(out), exec));
+  });
+  return out;
+}
+
+double psnr(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  double se = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double d = support::display_luma(a[i]) - support::display_luma(b[i]);
+    se += d * d;
+  }
+  return se == 0.0 ? 200.0 : 10.0 * std::log10(double(a.size()) / se);
+}
+
+}  // namespace
+
+TEST_CASE("frame reuse: the first frame and a frame after invalidate() are fresh frames, bit for bit",
+          "[upsample][frame_reuse]") {
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE(reuse);
+  auto up = make_upsampler();
+  std::size_t fresh_evaluated = 0;
+  const auto first = reuse_frame(*reuse, up, base_camera());
+  CHECK(same_frame(first, fresh(base_camera(), &fresh_evaluated)));
+  CHECK(up.stats().evaluated() == fresh_evaluated);
+  CHECK(reuse->stats().reused == 0);
+  const auto second = reuse_frame(*reuse, up, moved(0.05f));
+  CHECK(reuse->stats().reused > 0);
+  CHECK_FALSE(same_frame(second, fresh(moved(0.05f))));  // reuse changed something: the check below means something
+  reuse->invalidate();
+  CHECK_FALSE(reuse->has_history());
+  const auto third = reuse_frame(*reuse, up, moved(0.05f));
+  CHECK(same_frame(third, fresh(moved(0.05f), &fresh_evaluated)));
+  CHECK(up.stats().evaluated() == fresh_evaluated);
+  CHECK(reuse->stats().reused == 0);
+}
+
+TEST_CASE("frame reuse: a camera standing still reuses every sample and repeats the frame bit for bit",
+          "[upsample][frame_reuse]") {
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE(reuse);
+  auto up = make_upsampler();
+  const auto first = reuse_frame(*reuse, up, base_camera());
+  const std::size_t first_evaluated = reuse->stats().evaluated;
+  CHECK(first_evaluated > 0);
+  for (int k = 0; k < 3; ++k) {
+    const auto again = reuse_frame(*reuse, up, base_camera());
+    CHECK(same_frame(again, first));
+    CHECK(reuse->stats().evaluated == 0);
+    CHECK(reuse->stats().reused > 0);
+  }
+}
+
+TEST_CASE("frame reuse: a small move stays close to the fresh frame; a camera cut falls back to a fresh frame",
+          "[upsample][frame_reuse]") {
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE(reuse);
+  auto up = make_upsampler();
+  (void)reuse_frame(*reuse, up, base_camera());
+  const auto step = reuse_frame(*reuse, up, moved(0.03f, 0.02f));
+  const double reused = reuse->stats().reused_fraction();
+  CHECK(reused > 0.5 * (reused + reuse->stats().evaluated_fraction()));  // most evaluations served
+  const auto ref = fresh(moved(0.03f, 0.02f));
+  CHECK(psnr(step, ref) > 35.0);
+  // A cut: looking down at the ground in front of the camera, below the previous view's frame.
+  support::camera cut = base_camera();
+  cut.eye = {0.0f, -7.1f, 1.0f};
+  cut.target = {0.0f, -7.2f, 0.0f};
+  std::size_t fresh_evaluated = 0;
+  const auto after_cut = reuse_frame(*reuse, up, cut);
+  CHECK(reuse->stats().reused == 0);
+  CHECK(same_frame(after_cut, fresh(cut, &fresh_evaluated)));
+  CHECK(up.stats().evaluated() == fresh_evaluated);
+}
+
+TEST_CASE("frame reuse: with refined probes where sources differ, fresh after invalidate() and repeated when standing",
+          "[upsample][frame_reuse]") {
+  const infolerp::upsampler_options sparse{.passes = 4, .max_passes = 4, .keep_ibuffer = true, .min_sources = 1,
+                                           .probe_every_sample = false};
+  auto up = infolerp::upsampler<sample>::create(W, H, sparse);
+  auto plain = infolerp::upsampler<sample>::create(W, H, sparse);
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE((up && plain && reuse));
+  std::vector<glm::vec3> out(std::size_t{W} * H), fresh_out(out.size()), first(out.size());
+  const auto frame = [&](const support::camera& c) {
+    with_view<probe_mode::refine>(c, [&](const auto& src, const infolerp::pinhole_frame& view) {
+      REQUIRE(reuse->render(*up, src, view, std::span<glm::vec3>(out)));
+      REQUIRE(plain->render(src, std::span<glm::vec3>(fresh_out)));
+    });
+  };
+  frame(base_camera());
+  CHECK(same_frame(out, fresh_out));
+  first = out;
+  frame(base_camera());
+  CHECK(same_frame(out, first));
+  CHECK(reuse->stats().evaluated == 0);
+  frame(moved(0.05f));
+  CHECK(reuse->stats().reused > 0);
+  CHECK(psnr(out, fresh_out) > 35.0);
+  reuse->invalidate();
+  frame(moved(0.05f));
+  CHECK(same_frame(out, fresh_out));
+}
+
+TEST_CASE("frame reuse: every executor gives the same frames", "[upsample][frame_reuse]") {
+  const auto path = [](auto exec) {
+    auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+    REQUIRE(reuse);
+    auto up = make_upsampler();
+    std::vector<std::vector<glm::vec3>> frames;
+    for (int f = 0; f < 4; ++f) frames.push_back(reuse_frame(*reuse, up, moved(0.04f * float(f), 0.01f * float(f)), exec));
+    return frames;
+  };
+  const auto serial = path(infolerp::serial_executor{});
+  const auto check = [&](const auto& frames) {
+    REQUIRE(frames.size() == serial.size());
+    for (std::size_t f = 0; f < frames.size(); ++f) CHECK(same_frame(frames[f], serial[f]));
+  };
+  check(path(support::thread_pool_executor{2}));
+  check(path(support::thread_pool_executor{8}));
+#ifdef _OPENMP
+  check(path(infolerp::openmp_executor{}));
+#endif
+}
+
+TEST_CASE("frame reuse: bad input is named", "[upsample][frame_reuse][bad_input]") {
+  CHECK(infolerp::frame_reuse<sample>::create(0, H).error().code() == infolerp::errc::empty_input);
+  CHECK(infolerp::frame_reuse<sample>::create(W, H, {.depth_tolerance = -1.0f}).error().code() ==
+        infolerp::errc::bad_parameter);
+  auto reuse = infolerp::frame_reuse<sample>::create(W, H);
+  REQUIRE(reuse);
+  auto up = make_upsampler();
+  std::vector<glm::vec3> out(std::size_t{W} * H);
+  with_view(base_camera(), [&](const auto& src, const infolerp::pinhole_frame& view) {
+    // A camera whose image is another size.
+    infolerp::pinhole_frame other = view;
+    other.width = W + 1;
+    const infolerp::status s = reuse->render(up, src, other, std::span<glm::vec3>(out));
+    CHECK(s.code() == infolerp::errc::bad_size);
+    CHECK(s.message().find("97x72") != std::string::npos);
+    // An upsampler that does not keep its I-Buffer.
+    auto plain = infolerp::upsampler<sample>::create(W, H, {.passes = 3, .max_passes = 3});
+    REQUIRE(plain);
+    CHECK(reuse->render(*plain, src, view, std::span<glm::vec3>(out)).code() == infolerp::errc::bad_parameter);
+    // Ids whose meaning changed without invalidate().
+    REQUIRE(reuse->render(up, src, view, std::span<glm::vec3>(out), infolerp::serial_executor{}, 1));
+    const infolerp::status ids = reuse->render(up, src, view, std::span<glm::vec3>(out), infolerp::serial_executor{}, 2);
+    CHECK(ids.code() == infolerp::errc::bad_parameter);
+    CHECK(ids.message().find("1 -> 2") != std::string::npos);
+    reuse->invalidate();
+    CHECK(reuse->render(up, src, view, std::span<glm::vec3>(out), infolerp::serial_executor{}, 2));
+    // A camera frame that is not finite.
+    infolerp::pinhole_frame broken = view;
+    broken.eye.x = std::nanf("");
+    CHECK(reuse->render(up, src, broken, std::span<glm::vec3>(out)).code() == infolerp::errc::bad_parameter);
+  });
+}
+
+// ---- An analytic scene: the plane z = 0 (cluster 0) and a sphere (cluster 1) under a sun
+// whose soft shadow is a smooth function of the distance between the sun ray and the sphere's
+// centre (occlusion[0]); the probe is the primary hit without it.
+namespace {
+
+using asample = infolerp::surface_sample<1, false>;
+
+struct sphere_scene {
+  glm::vec3 centre{0.0f, 0.0f, 1.0f};
+  float radius = 0.8f;
+  glm::vec3 to_sun = glm::normalize(glm::vec3(0.6f, 0.2f, 1.0f));
+  // Visible fraction of the sun at p: 0 deep in the sphere's shadow, 1 outside its penumbra.
+  float sun_visible(glm::vec3 p) const {
+    const glm::vec3 d = centre - p;
+    const float along = glm::dot(d, to_sun);
+    if (along <= 0.0f) return 1.0f;
+    const float dist = glm::length(d - along * to_sun);
+    return std::clamp((dist - 0.7f * radius) / (0.6f * radius), 0.0f, 1.0f);
+  }
+};
+
+struct analytic_source {
+  using sample_type = asample;
+  const sphere_scene* sc = nullptr;
+  infolerp::pinhole_frame view{};
+
+  asample probe(std::uint32_t x, std::uint32_t y) const {
+    const infolerp::ray r = view.primary_ray(x, y);
+    asample s;
+    float best = 1e30f;
+    const glm::vec3 oc = r.origin - sc->centre;
+    const float b = glm::dot(oc, r.direction), c = glm::dot(oc, oc) - sc->radius * sc->radius, disc = b * b - c;
+    if (disc >= 0.0f && -b - std::sqrt(disc) > 0.0f) {
+      best = -b - std::sqrt(disc);
+      s.cluster = 1;
+    }
+    if (r.direction.z < 0.0f) {
+      const float t = -r.origin.z / r.direction.z;
+      if (t < best) {
+        best = t;
+        s.cluster = 0;
+      }
+    }
+    if (s.background()) return s;
+    s.position = r.origin + best * r.direction;
+    s.normal = s.cluster == 1 ? glm::normalize(s.position - sc->centre) : glm::vec3(0.0f, 0.0f, 1.0f);
+    s.inv_depth = 1.0f / glm::dot(s.position - view.eye, view.forward);
+    return s;
+  }
+  asample evaluate(std::uint32_t x, std::uint32_t y) const {
+    asample s = probe(x, y);
+    if (!s.background()) s.occlusion[0] = s.cluster == 1 ? 1.0f : sc->sun_visible(s.position);
+    return s;
+  }
+  float shade(const asample& s, std::uint32_t, std::uint32_t) const { return s.background() ? -1.0f : s.occlusion[0]; }
+};
+
+infolerp::pinhole_frame analytic_view() {
+  const infolerp::pinhole_camera cam{.eye = {0.0f, -6.0f, 4.0f}, .target = {0.5f, 0.5f, 0.0f}, .up = {0.0f, 0.0f, 1.0f},
+                                     .vertical_fov_degrees = 50.0f, .width = W, .height = H};
+  return cam.frame();
+}
+
+// Whether a kept sample may change when the sphere moves from a to b: on the sphere, or its
+// sun ray passes within the penumbra's reach of either centre (what a user knows of its change).
+struct touched_by_move {
+  sphere_scene a, b;
+  bool operator()(const asample& s) const {
+    if (s.background()) return false;
+    return s.cluster == 1 || a.sun_visible(s.position) < 1.0f || b.sun_visible(s.position) < 1.0f;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("frame reuse: a moved object invalidated by the user never shows stale occlusion", "[upsample][frame_reuse]") {
+  const sphere_scene before{};
+  sphere_scene after = before;
+  after.centre += glm::vec3(-0.9f, 0.6f, 0.0f);
+  const infolerp::pinhole_frame view = analytic_view();
+  const analytic_source src_before{&before, view}, src_after{&after, view};
+  auto up = infolerp::upsampler<asample>::create(W, H, {.passes = 3, .max_passes = 3, .keep_ibuffer = true});
+  REQUIRE(up);
+  std::vector<float> fresh_before(std::size_t{W} * H), fresh_after(fresh_before.size()), out(fresh_before.size());
+  REQUIRE(up->render(src_before, std::span<float>(fresh_before)));
+  REQUIRE(up->render(src_after, std::span<float>(fresh_after)));
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) changed += std::abs(fresh_before[i] - fresh_after[i]) > 0.05f ? 1 : 0;
+  REQUIRE(changed > 100);  // the move changes a visible part of the shadow
+
+  // Worst difference from the fresh frame of the moved scene over the changed pixels.
+  const auto stale_error = [&](bool invalidate) {
+    auto reuse = infolerp::frame_reuse<asample>::create(W, H);
+    REQUIRE(reuse);
+    REQUIRE(reuse->render(*up, src_before, view, std::span<float>(out)));
+    if (invalidate) reuse->invalidate_if(touched_by_move{before, after});
+    REQUIRE(reuse->render(*up, src_after, view, std::span<float>(out)));
+    CHECK(reuse->stats().reused > 0);
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (std::abs(fresh_before[i] - fresh_after[i]) > 0.05f) worst = std::max(worst, std::abs(out[i] - fresh_after[i]));
+    return worst;
+  };
+  CHECK(stale_error(true) == 0.0f);  // the camera stands still: what is not stale is the fresh frame's own
+  CHECK(stale_error(false) > 0.5f);  // without invalidation the old shadow shows
+}
+
+TEST_CASE("frame reuse: warm frames along a path allocate nothing", "[upsample][frame_reuse]") {
+  const sphere_scene sc{};
+  auto up = infolerp::upsampler<asample>::create(W, H, {.passes = 3, .max_passes = 3, .keep_ibuffer = true});
+  REQUIRE(up);
+  auto reuse = infolerp::frame_reuse<asample>::create(W, H);
+  REQUIRE(reuse);
+  std::vector<float> out(std::size_t{W} * H);
+  infolerp::pinhole_camera cam{.eye = {0.0f, -6.0f, 4.0f}, .target = {0.5f, 0.5f, 0.0f}, .up = {0.0f, 0.0f, 1.0f},
+                               .vertical_fov_degrees = 50.0f, .width = W, .height = H};
+  REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+  const std::size_t before = support::heap_allocations.load();
+  std::size_t reused = 0;
+  for (int f = 1; f <= 4; ++f) {
+    cam.eye.x += 0.02f;
+    REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+    reused += reuse->stats().reused;
+  }
+  CHECK(support::heap_allocations.load() == before);
+  CHECK(reused > 0);
+  const std::vector<int> probe_counter(4);  // the counter sees this file's allocations
+  CHECK(support::heap_allocations.load() > before);
+}
