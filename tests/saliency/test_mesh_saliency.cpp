@@ -342,7 +342,7 @@ TEST_CASE("saliency proxy: identical bits for any executor and thread count") {
   }
 }
 
-TEST_CASE("saliency proxy: the cell grouping and its sort are the same through any executor, and match a map") {
+TEST_CASE("saliency proxy: the cell grouping and its merge of sorted runs are the same through any executor, and match a map") {
   // Enough points for many chunks of each parallel step (sort runs, cell starts, cell sums,
   // neighbour lists), in clusters so that cells hold several points.
   infolerp::detail::vertex_points pts;
@@ -395,8 +395,12 @@ TEST_CASE("saliency proxy: the cell grouping and its sort are the same through a
   for (std::size_t k = 0; k < keyed.size(); ++k) keyed[k] = {static_cast<std::uint64_t>(next() * 1000.0), static_cast<std::uint32_t>(k)};
   auto sorted = keyed;
   std::sort(sorted.begin(), sorted.end());
+  // Runs of 7001 sorted, then merged through a pool (the last run shorter).
+  for (std::size_t b = 0; b < keyed.size(); b += 7001)
+    std::sort(keyed.begin() + static_cast<std::ptrdiff_t>(b),
+              keyed.begin() + static_cast<std::ptrdiff_t>(std::min(keyed.size(), b + 7001)));
   infolerp::support::thread_pool_executor pool{3};
-  infolerp::detail::parallel_sort(pool, keyed);
+  infolerp::detail::merge_sorted_runs(pool, keyed, 7001);
   CHECK(keyed == sorted);
 }
 

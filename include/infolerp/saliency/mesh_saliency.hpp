@@ -222,11 +222,9 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
                                           out.levels[i], is_max);
   });
   out.saliency.assign(nv, 0.0);
-  for_each_chunk(exec, nv, 8192, [&](std::size_t, std::size_t b, std::size_t e) {
-    for (std::size_t i = 0; i < levels; ++i)
-      if (factor[i] != 0.0)
-        for (std::size_t v = b; v < e; ++v) out.saliency[v] += out.levels[i][v] * factor[i];
-  });
+  for (std::size_t i = 0; i < levels; ++i)
+    if (factor[i] != 0.0)
+      for (std::size_t v = 0; v < nv; ++v) out.saliency[v] += out.levels[i][v] * factor[i];
   return out;
 }
 

@@ -38,17 +38,13 @@ struct proxy_cells {
   double h = 1.0;
 };
 
-// Sorts v ascending through exec: runs of a fixed length sorted in parallel, then merged in
-// pairs, each round's merges in parallel. The elements must be distinct (or equal only when
-// identical), so the result is the one sorted order whatever the executor. O(n log n) work,
+// Sorted runs of v ([k·run, (k+1)·run) each ascending) merged in pairs through exec, each round's
+// merges in parallel. The elements must be distinct (or equal only when identical), so the
+// result is the one sorted order whatever the executor and run length. O(n log(n / run)) work,
 // allocation O(n).
 template <class E, class T>
-void parallel_sort(E& exec, std::vector<T>& v) {
-  constexpr std::size_t run = std::size_t{1} << 15;
+void merge_sorted_runs(E& exec, std::vector<T>& v, std::size_t run) {
   const std::size_t n = v.size();
-  for_each_chunk(exec, n, run, [&](std::size_t, std::size_t b, std::size_t e) {
-    std::sort(v.begin() + static_cast<std::ptrdiff_t>(b), v.begin() + static_cast<std::ptrdiff_t>(e));
-  });
   if (n <= run) return;
   std::vector<T> merged(n);
   for (std::size_t width = run; width < n; width *= 2) {
@@ -76,12 +72,15 @@ proxy_cells make_proxy_cells(E& exec, const vertex_points& pts, double h) {
   for (std::size_t k = 0; k < P; ++k)
     lo[0] = std::min(lo[0], pts.x[k]), lo[1] = std::min(lo[1], pts.y[k]), lo[2] = std::min(lo[2], pts.z[k]);
   auto cell = [&](double v, int axis) { return static_cast<std::uint64_t>(std::floor((v - lo[axis]) / h)) + 1; };
+  // Keys and their sorted runs in one parallel phase, then the runs merged.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
-  for_each_chunk(exec, P, chunk, [&](std::size_t, std::size_t b, std::size_t e) {
+  const std::size_t run = std::max<std::size_t>(chunk, (P + 7) / 8);
+  for_each_chunk(exec, P, run, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
       keyed[k] = {cell(pts.x[k], 0) << 42 | cell(pts.y[k], 1) << 21 | cell(pts.z[k], 2), static_cast<std::uint32_t>(k)};
+    std::sort(keyed.begin() + static_cast<std::ptrdiff_t>(b), keyed.begin() + static_cast<std::ptrdiff_t>(e));
   });
-  parallel_sort(exec, keyed);
+  merge_sorted_runs(exec, keyed, run);
   // Cell starts: per chunk of sorted points the positions where a new key begins, then their
   // offsets in chunk order.
   const std::size_t chunks = chunk_count(P, chunk);
@@ -160,11 +159,15 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
+  // The finest grouping (all the points) runs through exec; the coarser ones, a fraction of its
+  // size each, serially (their parallel phases cost more in barriers than they gain).
+  serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
-    proxies[u] = make_proxy_cells(exec, u == 0 ? pts : proxies[u - 1].points, sigma[u] / cells_per_sigma);
-    for_each_chunk(exec, P, 8192, [&](std::size_t, std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) cell_of[u][i] = proxies[u].cell_of[u == 0 ? proxies[0].order[i] : cell_of[u - 1][i]];
-    });
+    if (u == 0)
+      proxies[u] = make_proxy_cells(exec, pts, sigma[u] / cells_per_sigma);
+    else
+      proxies[u] = make_proxy_cells(serial, proxies[u - 1].points, sigma[u] / cells_per_sigma);
+    for (std::size_t i = 0; i < P; ++i) cell_of[u][i] = proxies[u].cell_of[u == 0 ? proxies[0].order[i] : cell_of[u - 1][i]];
   }
   // Blend: points in cell order (so that neighbouring points read neighbouring proxies), each
   // proxy's position and average side by side.
@@ -185,15 +188,13 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
     kernel(exec, 0);
   } else {
     exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
-      serial_executor serial;
-      for (std::size_t u = b; u < e; ++u) kernel(serial, u);
+      serial_executor one;
+      for (std::size_t u = b; u < e; ++u) kernel(one, u);
     });
   }
   const std::vector<std::uint32_t>& order = proxies[0].order;
   std::vector<double> sx(P), sy(P), sz(P);
-  for_each_chunk(exec, P, 8192, [&](std::size_t, std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) sx[i] = pts.x[order[i]], sy[i] = pts.y[order[i]], sz[i] = pts.z[order[i]];
-  });
+  for (std::size_t i = 0; i < P; ++i) sx[i] = pts.x[order[i]], sy[i] = pts.y[order[i]], sz[i] = pts.z[order[i]];
   std::vector<double> avg(L * P);
   constexpr std::size_t chunk = 4096;
   exec.parallel_for((P + chunk - 1) / chunk, 1, [&](std::size_t b, std::size_t e) {
