@@ -159,14 +159,15 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
-  // The finest grouping (all the points) runs through exec; the coarser ones, a fraction of its
-  // size each, serially (their parallel phases cost more in barriers than they gain).
+  // Large groupings (the finest: all the points) run through exec; the smaller ones serially
+  // (their parallel phases cost more in barriers than they gain).
   serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
-    if (u == 0)
-      proxies[u] = make_proxy_cells(exec, pts, sigma[u] / cells_per_sigma);
+    const vertex_points& grouped = u == 0 ? pts : proxies[u - 1].points;
+    if (grouped.x.size() >= (std::size_t{1} << 17))
+      proxies[u] = make_proxy_cells(exec, grouped, sigma[u] / cells_per_sigma);
     else
-      proxies[u] = make_proxy_cells(serial, proxies[u - 1].points, sigma[u] / cells_per_sigma);
+      proxies[u] = make_proxy_cells(serial, grouped, sigma[u] / cells_per_sigma);
     for (std::size_t i = 0; i < P; ++i) cell_of[u][i] = proxies[u].cell_of[u == 0 ? proxies[0].order[i] : cell_of[u - 1][i]];
   }
   // Blend: points in cell order (so that neighbouring points read neighbouring proxies), each
