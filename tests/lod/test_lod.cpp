@@ -124,6 +124,55 @@ TEST_CASE("weighting map: amplification and smoothing on hand-made maps", "[lod]
   for (std::size_t k = 0; k < sorted.size(); ++k) CHECK((*full)[k] == ((*local)[k] >= alpha ? 100.0 * (*local)[k] : (*local)[k]));
 }
 
+TEST_CASE("weighting map: smoothing over the saliency proxy", "[lod]") {
+  // A plane with a rough map: fine proxy cells (one vertex each) give exact's smoothing, the
+  // automatic method switches at exact_below, any executor gives the same bits.
+  const indexed_mesh m = support::make_plane(60, 60, 1.0f);
+  std::vector<double> sal(m.vertex_count());
+  for (std::size_t k = 0; k < sal.size(); ++k) sal[k] = static_cast<double>((k * 7919) % 13);
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  const weighting_map_options exact{.epsilon = 0.02, .smoothing_method = saliency_method::exact};
+  auto e = weighting_map(m, sal, cl, 8, exact);
+  REQUIRE(e.ok());
+  auto with = [&](saliency_method method, double cells, std::size_t exact_below = 200000) {
+    weighting_map_options o = exact;
+    o.smoothing_method = method, o.proxy_cells_per_sigma = cells, o.exact_below = exact_below;
+    return o;
+  };
+  // σ_s = 3 · 0.02 · √2 = 0.085; the spacing is 1/60: at 32 cells per σ_s a cell is 0.0027 wide.
+  auto fine = weighting_map(m, sal, cl, 8, with(saliency_method::proxy, 32.0));
+  REQUIRE(fine.ok());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < e->size(); ++k) worst = std::max(worst, std::abs((*fine)[k] - (*e)[k]));
+  CHECK(worst < 1e-9);
+  auto coarse = weighting_map(m, sal, cl, 8, with(saliency_method::proxy, 2.0));
+  REQUIRE(coarse.ok());
+  CHECK(*coarse != *e);  // cells of several vertices: an approximation
+  auto below = weighting_map(m, sal, cl, 8, with(saliency_method::automatic, 2.0, m.vertex_count() + 1));
+  auto at = weighting_map(m, sal, cl, 8, with(saliency_method::automatic, 2.0, m.vertex_count()));
+  REQUIRE(below.ok());
+  REQUIRE(at.ok());
+  CHECK(*below == *e);
+  CHECK(*at == *coarse);
+  for (unsigned workers : {2u, 3u}) {
+    auto par = weighting_map(m, sal, cl, 8, with(saliency_method::proxy, 2.0), support::thread_pool_executor(workers));
+    REQUIRE(par.ok());
+    CHECK(*par == *coarse);
+  }
+  // Bad options name themselves.
+  for (double cells : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), 1e7}) {
+    INFO("proxy_cells_per_sigma " << cells);
+    auto r = weighting_map(m, sal, cl, 8, with(saliency_method::proxy, cells));
+    REQUIRE(!r.ok());
+    CHECK(r.error().code() == errc::bad_parameter);
+    CHECK(r.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  }
+  CHECK(weighting_map(m, sal, cl, 8, with(saliency_method::exact, 1e7)).ok());  // unused by exact
+  auto bad = weighting_map(m, sal, cl, 8, with(static_cast<saliency_method>(7), 2.0));
+  REQUIRE(!bad.ok());
+  CHECK(bad.error().message().find("smoothing_method") != std::string::npos);
+}
+
 TEST_CASE("a plane of many triangles simplifies to two with zero error", "[lod]") {
   const indexed_mesh m = support::make_plane(12, 9, 2.0f);
   const std::vector<std::uint32_t> cl(m.triangle_count(), 0);

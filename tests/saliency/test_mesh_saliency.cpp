@@ -3,6 +3,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <utility>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -336,6 +340,68 @@ TEST_CASE("saliency proxy: identical bits for any executor and thread count") {
       CHECK(par->levels == serial->levels);
     }
   }
+}
+
+TEST_CASE("saliency proxy: the cell grouping and its merge of sorted runs are the same through any executor, and match a map") {
+  // Enough points for many chunks of each parallel step (sort runs, cell starts, cell sums,
+  // neighbour lists), in clusters so that cells hold several points.
+  infolerp::detail::vertex_points pts;
+  std::uint64_t state = 12345;
+  auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) * 0x1p-53;
+  };
+  for (int k = 0; k < 150000; ++k) {
+    pts.x.push_back(std::floor(next() * 60.0) + 0.5 * next()), pts.y.push_back(next() * 40.0), pts.z.push_back(next() * 3.0);
+    pts.value.push_back(next() - 0.5), pts.id.push_back(static_cast<std::uint32_t>(k));
+  }
+  for (bool weighted : {false, true}) {
+    if (weighted)
+      for (int k = 0; k < 150000; ++k) pts.weight.push_back(1.0 + next());
+    infolerp::serial_executor serial;
+    const auto ref = infolerp::detail::make_proxy_cells(serial, pts, 0.7);
+    // Against a map of the cells: the same cells, each with its points' value sum and count.
+    std::map<std::array<std::int64_t, 3>, std::pair<double, double>> cells;
+    const double lo[3] = {*std::min_element(pts.x.begin(), pts.x.end()), *std::min_element(pts.y.begin(), pts.y.end()),
+                          *std::min_element(pts.z.begin(), pts.z.end())};
+    for (std::size_t k = 0; k < pts.x.size(); ++k) {
+      auto& c = cells[{static_cast<std::int64_t>(std::floor((pts.x[k] - lo[0]) / 0.7)),
+                       static_cast<std::int64_t>(std::floor((pts.y[k] - lo[1]) / 0.7)),
+                       static_cast<std::int64_t>(std::floor((pts.z[k] - lo[2]) / 0.7))}];
+      c.first += pts.value[k], c.second += weighted ? pts.weight[k] : 1.0;
+    }
+    REQUIRE(ref.points.x.size() == cells.size());
+    std::size_t i = 0, off = 0;
+    for (const auto& [key, sums] : cells) {  // the map's order is the cells' key order
+      off += std::abs(ref.points.value[i] - sums.first) > 1e-9 || std::abs(ref.points.weight[i] - sums.second) > 1e-9 ? 1 : 0;
+      ++i;
+    }
+    CHECK(off == 0);
+    for (unsigned workers : {2u, 3u}) {
+      infolerp::support::thread_pool_executor pool{workers};
+      const auto par = infolerp::detail::make_proxy_cells(pool, pts, 0.7);
+      CHECK(par.points.x == ref.points.x);
+      CHECK(par.points.y == ref.points.y);
+      CHECK(par.points.z == ref.points.z);
+      CHECK(par.points.value == ref.points.value);
+      CHECK(par.points.weight == ref.points.weight);
+      CHECK(par.cell_of == ref.cell_of);
+      CHECK(par.order == ref.order);
+      CHECK(par.near_start == ref.near_start);
+      CHECK(par.near == ref.near);
+    }
+  }
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(300000);
+  for (std::size_t k = 0; k < keyed.size(); ++k) keyed[k] = {static_cast<std::uint64_t>(next() * 1000.0), static_cast<std::uint32_t>(k)};
+  auto sorted = keyed;
+  std::sort(sorted.begin(), sorted.end());
+  // Runs of 7001 sorted, then merged through a pool (the last run shorter).
+  for (std::size_t b = 0; b < keyed.size(); b += 7001)
+    std::sort(keyed.begin() + static_cast<std::ptrdiff_t>(b),
+              keyed.begin() + static_cast<std::ptrdiff_t>(std::min(keyed.size(), b + 7001)));
+  infolerp::support::thread_pool_executor pool{3};
+  infolerp::detail::merge_sorted_runs(pool, keyed, 7001);
+  CHECK(keyed == sorted);
 }
 
 TEST_CASE("saliency: the automatic method is exact below exact_below referenced vertices, proxy from there") {

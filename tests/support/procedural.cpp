@@ -162,17 +162,35 @@ indexed_mesh subdivide_midpoint(const indexed_mesh& in) {
 
 namespace infolerp::support {
 indexed_mesh weld_positions(const indexed_mesh& m, std::vector<std::uint32_t>& remap) {
+  // Sorted by position, ties by index (a std::map of the positions took 8x the time for 4x the
+  // vertices at 150k to 600k): each vertex joins the first of its equal run, and the kept
+  // positions come in order of first occurrence. The positions are sorted with their indices,
+  // side by side, so that the sort reads memory in order.
+  struct keyed {
+    glm::vec3 p;
+    std::uint32_t v;
+  };
   auto less = [](const glm::vec3& a, const glm::vec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   };
-  std::map<glm::vec3, std::uint32_t, decltype(less)> index(less);
+  const std::size_t n = m.positions.size();
+  std::vector<keyed> order(n);
+  for (std::size_t v = 0; v < n; ++v) order[v] = {m.positions[v], static_cast<std::uint32_t>(v)};
+  std::sort(order.begin(), order.end(), [&](const keyed& a, const keyed& b) { return less(a.p, b.p) || (!less(b.p, a.p) && a.v < b.v); });
+  std::vector<std::uint32_t> first(n);
+  for (std::size_t k = 0; k < n; ++k)
+    first[order[k].v] = k > 0 && !less(order[k - 1].p, order[k].p) ? first[order[k - 1].v] : order[k].v;
   indexed_mesh out;
-  remap.resize(m.positions.size());
-  for (std::size_t v = 0; v < m.positions.size(); ++v) {
-    const auto [it, added] = index.emplace(m.positions[v], static_cast<std::uint32_t>(out.positions.size()));
-    if (added) out.positions.push_back(m.positions[v]);
-    remap[v] = it->second;
+  remap.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (first[v] == v) {
+      remap[v] = static_cast<std::uint32_t>(out.positions.size());
+      out.positions.push_back(m.positions[v]);
+    } else {
+      remap[v] = remap[first[v]];
+    }
   }
+  out.triangles.reserve(m.triangles.size());
   for (const auto& t : m.triangles) out.triangles.push_back({remap[t.x], remap[t.y], remap[t.z]});
   out.texcoords = m.texcoords;
   return out;

@@ -6,6 +6,10 @@
 //   1. smoothing: G(S, σ_s)(v) = Σ_{|x−v| ≤ 2σ_s} S(x) w / Σ w, w = exp(−|x−v|²/2σ_s²), over the
 //      referenced vertices (the same Gaussian ball average as mesh_saliency.hpp), σ_s =
 //      smoothing_scale · ε, ε = epsilon × bounding-box diagonal (defaults 3 and 0.3%: Lee's 3ε);
+//      the ball sums are exact, or (smoothing_method, as compute_saliency's: by default from
+//      exact_below referenced vertices on) taken over saliency's proxy
+//      (saliency/detail/proxy_ball_averages.hpp), whose cost per vertex does not grow with the
+//      resolution while the exact pairs within 2σ_s grow with its square;
 //   2. localisation: eq. 4 applied per triangle corner to the smoothed values (min, max and mean
 //      over the vertices of the corner's cluster). Eq. 4 is affine per cluster and the Gaussian
 //      is linear, so this equals smoothing the localised map, except that the cluster's min, max
@@ -45,6 +49,9 @@ struct weighting_map_options {
   double amplify_percentile = 30.0;  // α: corner values at or above this percentile are amplified, in [0, 100]
   double amplification = 1.0;       // λ >= 1; 1 skips the amplification (Lee et al.: 100)
   std::size_t grain = 1;            // tiles of the Gaussian kernel per parallel task
+  saliency_method smoothing_method = saliency_method::automatic;  // exact, proxy, or automatic (see exact_below)
+  std::size_t exact_below = 200000;     // automatic: exact smoothing below this many referenced vertices
+  double proxy_cells_per_sigma = 4.0;   // proxy: cells per σ_s along an axis (accuracy against time)
 };
 
 // Amplification step alone (step 3), in place over the corner values: values >= the
@@ -61,14 +68,18 @@ inline void amplify_weights(std::span<double> values, double percentile, double 
 }
 
 // Smoothing step alone (step 1): the Gaussian ball average of per-vertex values with
-// σ = sigma (mesh units); unreferenced vertices keep their value. Preconditions: valid mesh,
-// values.size() == V, sigma > 0 and finite. O(pairs within 2σ), allocation O(V). Identical
-// bits for any executor.
+// σ = sigma (mesh units); unreferenced vertices keep their value. proxy_cells_per_sigma 0: exact
+// ball sums, O(pairs within 2σ); > 0: over the proxy with that many cells per σ, O(V log V).
+// Preconditions: valid mesh, values.size() == V, sigma > 0 and finite, proxy_cells_per_sigma
+// >= 0 and finite with (bounding-box diagonal) · proxy_cells_per_sigma / sigma below
+// detail::proxy_max_cells. Allocation O(V). Identical bits for any executor.
 template <class M, class E = serial_executor>
 std::vector<double> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
-                                         std::size_t grain = 1) {
+                                         std::size_t grain = 1, double proxy_cells_per_sigma = 0.0) {
   const detail::vertex_points grid = detail::referenced_points(m, detail::referenced_vertices(m), values);
-  const std::vector<double> avg = detail::exact_gaussian_averages(exec, grid, {sigma}, grain);
+  const std::vector<double> avg = proxy_cells_per_sigma > 0.0
+                                      ? detail::proxy_gaussian_averages(exec, grid, {sigma}, proxy_cells_per_sigma, grain)
+                                      : detail::exact_gaussian_averages(exec, grid, {sigma}, grain);
   std::vector<double> out(values.begin(), values.end());
   for (std::size_t k = 0; k < grid.id.size(); ++k) out[grid.id[k]] = avg[k];
   return out;
@@ -81,7 +92,10 @@ std::vector<double> smooth_vertex_values(const M& m, std::span<const double> val
 // a zero bounding-box diagonal (degenerate_triangle); a weight that
 // overflows double for finite inputs, e.g. saliency near 1e300 or saliency × amplification
 // above 1.8e308 (bad_parameter, names the corner).
-// Complexity O(pairs within 2σ_s + T log T); allocation O(V + T). Parallel through exec;
+// Errors also: smoothing_method not one of the three, proxy_cells_per_sigma not positive and
+// finite or (proxy) so fine that its grid would pass detail::proxy_max_cells cells along the
+// diagonal (bad_parameter).
+// Complexity exact O(pairs within 2σ_s + T log T), proxy O(V log V + T log T); allocation O(V + T). Parallel through exec;
 // identical bits for any executor.
 template <class M, class E = serial_executor>
 result<std::vector<double>> weighting_map(const M& m, std::span<const double> saliency,
@@ -98,6 +112,13 @@ result<std::vector<double>> weighting_map(const M& m, std::span<const double> sa
     return make_error(errc::bad_parameter, no_element, "amplify_percentile ", opt.amplify_percentile, " must be in [0, 100]");
   if (!(opt.amplification >= 1.0) || !std::isfinite(opt.amplification))
     return make_error(errc::bad_parameter, no_element, "amplification ", opt.amplification, " must be >= 1 and finite");
+  if (opt.smoothing_method != saliency_method::automatic && opt.smoothing_method != saliency_method::exact &&
+      opt.smoothing_method != saliency_method::proxy)
+    return make_error(errc::bad_parameter, no_element, "weighting map smoothing_method ", static_cast<int>(opt.smoothing_method),
+                      " is not automatic, exact or proxy");
+  if (!(opt.proxy_cells_per_sigma > 0.0) || !std::isfinite(opt.proxy_cells_per_sigma))
+    return make_error(errc::bad_parameter, no_element, "weighting map proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
+                      " must be positive and finite");
   std::vector<double> smoothed(saliency.begin(), saliency.end());
   if (opt.smoothing_scale > 0.0) {
     const double diag = mesh_bounds(m).diagonal();
@@ -105,7 +126,15 @@ result<std::vector<double>> weighting_map(const M& m, std::span<const double> sa
     if (!(sigma * sigma >= std::numeric_limits<double>::min()) || !std::isfinite(16.0 * sigma * sigma))
       return make_error(diag > 0.0 ? errc::bad_parameter : errc::degenerate_triangle, no_element, "smoothing sigma ",
                         sigma, " (smoothing_scale x epsilon x bounding-box diagonal) is outside double precision");
-    smoothed = smooth_vertex_values(m, saliency, sigma, exec, opt.grain);
+    std::size_t referenced = 0;
+    for (const char u : detail::referenced_vertices(m)) referenced += u ? 1 : 0;
+    const bool proxy = opt.smoothing_method == saliency_method::proxy ||
+                       (opt.smoothing_method == saliency_method::automatic && referenced >= opt.exact_below);
+    if (proxy && !(diag * opt.proxy_cells_per_sigma / sigma < detail::proxy_max_cells))
+      return make_error(errc::bad_parameter, no_element, "weighting map proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
+                        " makes proxy cells of ", sigma / opt.proxy_cells_per_sigma, ", more than ", detail::proxy_max_cells,
+                        " along the bounding-box diagonal ", diag);
+    smoothed = smooth_vertex_values(m, saliency, sigma, exec, opt.grain, proxy ? opt.proxy_cells_per_sigma : 0.0);
   }
   auto local = cluster_localized_saliency(m, std::span<const double>(smoothed), cluster, cluster_count);
   if (!local.ok()) return local.error();

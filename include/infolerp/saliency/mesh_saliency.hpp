@@ -75,6 +75,51 @@ struct mesh_saliency {
   saliency_method method = saliency_method::exact;  // the one used (never automatic)
 };
 
+namespace detail {
+// One level of Lee's normalisation (see the top of the file): s receives S_i = |G(σ_lo) − G(σ_hi)|
+// per vertex (0 where unused); returns the factor N(S_i) = s · factor, or 0 when the level adds
+// nothing (flat: its range below `floor`, or so small that 1/range overflows). is_max: scratch of
+// V entries. O(V + T), serial.
+template <class M>
+double normalise_level(const M& m, const vertex_points& grid, const std::vector<char>& used, const std::vector<double>& avg,
+                       std::size_t lo, std::size_t hi, double floor, std::vector<double>& s, std::vector<char>& is_max) {
+  const std::size_t nv = used.size(), P = grid.x.size();
+  s.assign(nv, 0.0);
+  double mx = 0.0;
+  for (std::size_t k = 0; k < P; ++k) {
+    s[grid.id[k]] = std::abs(avg[lo * P + k] - avg[hi * P + k]);
+    mx = std::max(mx, s[grid.id[k]]);
+  }
+  const double range = std::max(mx, floor);
+  // A flat mesh, or a range so small that 1/range overflows: this level adds nothing.
+  if (!(range >= std::numeric_limits<double>::min())) return 0.0;
+  const double scale = 1.0 / range, big_m = mx * scale;
+  std::size_t global = nv;
+  for (std::size_t v = 0; v < nv; ++v) {
+    is_max[v] = used[v];
+    if (used[v] && global == nv && s[v] == mx) global = v;
+  }
+  const double tie = 1e-12 * mx;  // differences below this are rounding, not structure
+  // The triangles' edges (an edge shared by two triangles is met twice, which changes nothing;
+  // the (a, a) side of a degenerate triangle is no edge).
+  for (std::size_t t = 0; t < mesh_triangle_count(m); ++t) {
+    const glm::uvec3 tri = mesh_triangle(m, t);
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
+      if (a == b) continue;
+      if (s[a] <= s[b] + tie) is_max[a] = 0;
+      if (s[b] <= s[a] + tie) is_max[b] = 0;
+    }
+  }
+  double sum_max = 0.0;
+  std::size_t count_max = 0;
+  for (std::size_t v = 0; v < nv; ++v)
+    if (is_max[v] && v != global) sum_max += s[v] * scale, ++count_max;
+  const double mbar = count_max ? sum_max / static_cast<double>(count_max) : 0.0;
+  return scale * (big_m - mbar) * (big_m - mbar);
+}
+}  // namespace detail
+
 // Per-vertex mesh saliency of any infolerp::mesh (see the top of this file).
 // Errors: empty mesh, index out of range, non-finite position; method not one of the three,
 // epsilon <= 0 or not finite, no scales or more than 16 (counted as given, repeats included), a
@@ -161,50 +206,25 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
           ? detail::exact_gaussian_averages(exec, grid, sigma, opt.grain)
           : detail::proxy_gaussian_averages(exec, grid, sigma, opt.proxy_cells_per_sigma, opt.grain);
 
-  // Levels and Lee's normalisation.
+  // Levels and Lee's normalisation: the levels in parallel (each serially), then their sum per
+  // vertex in level order.
   double mean_abs_c = 0.0;
   for (std::size_t k = 0; k < P; ++k) mean_abs_c += std::abs(grid.value[k]);
   mean_abs_c /= static_cast<double>(P);
+  const std::size_t levels = opt.scales.size();
+  out.levels.resize(levels);
+  std::vector<double> factor(levels, 0.0);  // 0 for a level that adds nothing (skipped)
+  const double floor = opt.flat_level_threshold * mean_abs_c;
+  exec.parallel_for(levels, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<char> is_max(nv);
+    for (std::size_t i = b; i < e; ++i)
+      factor[i] = detail::normalise_level(m, grid, used, avg, index_of(opt.scales[i]), index_of(2.0 * opt.scales[i]), floor,
+                                          out.levels[i], is_max);
+  });
   out.saliency.assign(nv, 0.0);
-  out.levels.assign(opt.scales.size(), std::vector<double>(nv, 0.0));
-  std::vector<char> is_max(nv);
-  for (std::size_t i = 0; i < opt.scales.size(); ++i) {
-    std::vector<double>& s = out.levels[i];
-    const std::size_t lo = index_of(opt.scales[i]), hi = index_of(2.0 * opt.scales[i]);
-    double mx = 0.0;
-    for (std::size_t k = 0; k < P; ++k) {
-      s[grid.id[k]] = std::abs(avg[lo * P + k] - avg[hi * P + k]);
-      mx = std::max(mx, s[grid.id[k]]);
-    }
-    const double range = std::max(mx, opt.flat_level_threshold * mean_abs_c);
-    // A flat mesh, or a range so small that 1/range overflows: this level adds nothing.
-    if (!(range >= std::numeric_limits<double>::min())) continue;
-    const double scale = 1.0 / range, big_m = mx * scale;
-    std::size_t global = nv;
-    for (std::size_t v = 0; v < nv; ++v) {
-      is_max[v] = used[v];
-      if (used[v] && global == nv && s[v] == mx) global = v;
-    }
-    const double tie = 1e-12 * mx;  // differences below this are rounding, not structure
-    // The triangles' edges (an edge shared by two triangles is met twice, which changes nothing;
-    // the (a, a) side of a degenerate triangle is no edge).
-    for (std::size_t t = 0; t < mesh_triangle_count(m); ++t) {
-      const glm::uvec3 tri = mesh_triangle(m, t);
-      for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
-        if (a == b) continue;
-        if (s[a] <= s[b] + tie) is_max[a] = 0;
-        if (s[b] <= s[a] + tie) is_max[b] = 0;
-      }
-    }
-    double sum_max = 0.0;
-    std::size_t count_max = 0;
-    for (std::size_t v = 0; v < nv; ++v)
-      if (is_max[v] && v != global) sum_max += s[v] * scale, ++count_max;
-    const double mbar = count_max ? sum_max / static_cast<double>(count_max) : 0.0;
-    const double factor = scale * (big_m - mbar) * (big_m - mbar);
-    for (std::size_t v = 0; v < nv; ++v) out.saliency[v] += s[v] * factor;
-  }
+  for (std::size_t i = 0; i < levels; ++i)
+    if (factor[i] != 0.0)
+      for (std::size_t v = 0; v < nv; ++v) out.saliency[v] += out.levels[i][v] * factor[i];
   return out;
 }
 

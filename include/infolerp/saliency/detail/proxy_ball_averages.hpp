@@ -38,10 +38,32 @@ struct proxy_cells {
   double h = 1.0;
 };
 
+// Sorted runs of v ([k·run, (k+1)·run) each ascending) merged in pairs through exec, each round's
+// merges in parallel. The elements must be distinct (or equal only when identical), so the
+// result is the one sorted order whatever the executor and run length. O(n log(n / run)) work,
+// allocation O(n).
+template <class E, class T>
+void merge_sorted_runs(E& exec, std::vector<T>& v, std::size_t run) {
+  const std::size_t n = v.size();
+  if (n <= run) return;
+  std::vector<T> merged(n);
+  for (std::size_t width = run; width < n; width *= 2) {
+    for_each_chunk(exec, n, 2 * width, [&](std::size_t, std::size_t b, std::size_t e) {
+      const auto at = [](auto& x, std::size_t k) { return x.begin() + static_cast<std::ptrdiff_t>(k); };
+      const std::size_t mid = std::min(e, b + width);
+      std::merge(at(v, b), at(v, mid), at(v, mid), at(v, e), at(merged, b));
+    });
+    v.swap(merged);
+  }
+}
+
 // Groups the points (weighted or not) into cells of edge h: per cell the weighted centroid, the
 // sum of the values and of the weights (the caller guarantees the extent over h stays below
-// proxy_max_cells). O(P log P), allocation O(P).
-inline proxy_cells make_proxy_cells(const vertex_points& pts, double h) {
+// proxy_max_cells). Parallel through exec; every step is a function of the sorted keys, so the
+// result is the same for any executor. O(P log P), allocation O(P).
+template <class E>
+proxy_cells make_proxy_cells(E& exec, const vertex_points& pts, double h) {
+  constexpr std::size_t chunk = 8192;
   proxy_cells c;
   c.h = h;
   const std::size_t P = pts.x.size();
@@ -50,48 +72,77 @@ inline proxy_cells make_proxy_cells(const vertex_points& pts, double h) {
   for (std::size_t k = 0; k < P; ++k)
     lo[0] = std::min(lo[0], pts.x[k]), lo[1] = std::min(lo[1], pts.y[k]), lo[2] = std::min(lo[2], pts.z[k]);
   auto cell = [&](double v, int axis) { return static_cast<std::uint64_t>(std::floor((v - lo[axis]) / h)) + 1; };
+  // Keys and their sorted runs in one parallel phase, then the runs merged.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(P);
-  for (std::size_t k = 0; k < P; ++k)
-    keyed[k] = {cell(pts.x[k], 0) << 42 | cell(pts.y[k], 1) << 21 | cell(pts.z[k], 2), static_cast<std::uint32_t>(k)};
-  std::sort(keyed.begin(), keyed.end());
+  const std::size_t run = std::max<std::size_t>(chunk, (P + 7) / 8);
+  for_each_chunk(exec, P, run, [&](std::size_t, std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      keyed[k] = {cell(pts.x[k], 0) << 42 | cell(pts.y[k], 1) << 21 | cell(pts.z[k], 2), static_cast<std::uint32_t>(k)};
+    std::sort(keyed.begin() + static_cast<std::ptrdiff_t>(b), keyed.begin() + static_cast<std::ptrdiff_t>(e));
+  });
+  merge_sorted_runs(exec, keyed, run);
+  // Cell starts: per chunk of sorted points the positions where a new key begins, then their
+  // offsets in chunk order.
+  const std::size_t chunks = chunk_count(P, chunk);
+  std::vector<std::vector<std::uint32_t>> starts_of(chunks);
+  for_each_chunk(exec, P, chunk, [&](std::size_t ch, std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      if (k == 0 || keyed[k].first != keyed[k - 1].first) starts_of[ch].push_back(static_cast<std::uint32_t>(k));
+  });
+  std::vector<std::uint32_t> start;
+  for (const auto& s : starts_of) start.insert(start.end(), s.begin(), s.end());
+  start.push_back(static_cast<std::uint32_t>(P));
+  const std::size_t cells = start.size() - 1;
   c.order.resize(P);
-  for (std::size_t k = 0; k < P; ++k) c.order[k] = keyed[k].second;
-  std::vector<std::uint64_t> keys;
   c.cell_of.resize(P);
   vertex_points& q = c.points;
-  for (std::size_t b = 0; b < P;) {
-    double sx = 0.0, sy = 0.0, sz = 0.0, sv = 0.0, sw = 0.0;
-    std::size_t e = b;
-    for (; e < P && keyed[e].first == keyed[b].first; ++e) {
-      const std::uint32_t k = keyed[e].second;
-      const double w = pts.weight.empty() ? 1.0 : pts.weight[k];
-      sx += w * pts.x[k], sy += w * pts.y[k], sz += w * pts.z[k], sv += pts.value[k], sw += w;
-      c.cell_of[k] = static_cast<std::uint32_t>(keys.size());
+  q.x.resize(cells), q.y.resize(cells), q.z.resize(cells), q.value.resize(cells), q.weight.resize(cells), q.id.resize(cells);
+  std::vector<std::uint64_t> keys(cells);
+  for_each_chunk(exec, cells, chunk, [&](std::size_t, std::size_t cb, std::size_t ce) {
+    for (std::size_t i = cb; i < ce; ++i) {
+      double sx = 0.0, sy = 0.0, sz = 0.0, sv = 0.0, sw = 0.0;
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
+        const std::uint32_t k = keyed[e].second;
+        const double w = pts.weight.empty() ? 1.0 : pts.weight[k];
+        sx += w * pts.x[k], sy += w * pts.y[k], sz += w * pts.z[k], sv += pts.value[k], sw += w;
+        c.cell_of[k] = static_cast<std::uint32_t>(i);
+        c.order[e] = k;
+      }
+      q.x[i] = sx / sw, q.y[i] = sy / sw, q.z[i] = sz / sw, q.value[i] = sv, q.weight[i] = sw;
+      q.id[i] = static_cast<std::uint32_t>(i);
+      keys[i] = keyed[start[i]].first;
     }
-    q.x.push_back(sx / sw), q.y.push_back(sy / sw), q.z.push_back(sz / sw);
-    q.value.push_back(sv), q.weight.push_back(sw);
-    q.id.push_back(static_cast<std::uint32_t>(keys.size()));
-    keys.push_back(keyed[b].first);
-    b = e;
-  }
+  });
   // Neighbour cells: for each of the 9 (x, y) offsets the three z neighbours are consecutive
   // keys, and the queried keys grow with the proxy's key, so one pointer per offset walks the keys
-  // once (O(9·proxies) instead of a search per neighbour).
+  // (O(9·proxies) instead of a search per neighbour); each chunk of cells starts its pointers by
+  // a search, and the chunks' lists are joined in order.
   constexpr std::uint64_t one_x = std::uint64_t{1} << 42, one_y = std::uint64_t{1} << 21;
   std::uint64_t offset[9];
-  std::size_t at[9] = {};
   for (int o = 0; o < 9; ++o) offset[o] = static_cast<std::uint64_t>(o / 3) * one_x + static_cast<std::uint64_t>(o % 3) * one_y;
   const std::uint64_t centre = one_x + one_y + 1;  // key + offset[o] − centre: the cell below in z
-  c.near_start.push_back(0);
-  for (const std::uint64_t key : keys) {
-    for (int o = 0; o < 9; ++o) {
-      const std::uint64_t first = key + offset[o] - centre;
-      std::size_t& p = at[o];
-      while (p < keys.size() && keys[p] < first) ++p;
-      for (std::size_t i = p; i < keys.size() && keys[i] <= first + 2; ++i)
-        c.near.push_back(static_cast<std::uint32_t>(i));
+  const std::size_t cell_chunks = chunk_count(cells, chunk);
+  std::vector<std::vector<std::uint32_t>> near_of(cell_chunks), count_of(cell_chunks);
+  for_each_chunk(exec, cells, chunk, [&](std::size_t ch, std::size_t cb, std::size_t ce) {
+    std::size_t at[9];
+    for (int o = 0; o < 9; ++o)
+      at[o] = static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), keys[cb] + offset[o] - centre) - keys.begin());
+    for (std::size_t i = cb; i < ce; ++i) {
+      const std::size_t before = near_of[ch].size();
+      for (int o = 0; o < 9; ++o) {
+        const std::uint64_t first = keys[i] + offset[o] - centre;
+        std::size_t& p = at[o];
+        while (p < cells && keys[p] < first) ++p;
+        for (std::size_t j = p; j < cells && keys[j] <= first + 2; ++j) near_of[ch].push_back(static_cast<std::uint32_t>(j));
+      }
+      count_of[ch].push_back(static_cast<std::uint32_t>(near_of[ch].size() - before));
     }
-    c.near_start.push_back(static_cast<std::uint32_t>(c.near.size()));
+  });
+  c.near_start.reserve(cells + 1);
+  c.near_start.push_back(0);
+  for (std::size_t ch = 0; ch < cell_chunks; ++ch) {
+    c.near.insert(c.near.end(), near_of[ch].begin(), near_of[ch].end());
+    for (const std::uint32_t n : count_of[ch]) c.near_start.push_back(c.near_start.back() + n);
   }
   return c;
 }
@@ -108,28 +159,40 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
+  // Large groupings (the finest: all the points) run through exec; the smaller ones serially
+  // (their parallel phases cost more in barriers than they gain).
+  serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
-    proxies[u] = make_proxy_cells(u == 0 ? pts : proxies[u - 1].points, sigma[u] / cells_per_sigma);
-    for (std::size_t i = 0; i < P; ++i)
-      cell_of[u][i] = proxies[u].cell_of[u == 0 ? proxies[0].order[i] : cell_of[u - 1][i]];
+    const vertex_points& grouped = u == 0 ? pts : proxies[u - 1].points;
+    if (grouped.x.size() >= (std::size_t{1} << 17))
+      proxies[u] = make_proxy_cells(exec, grouped, sigma[u] / cells_per_sigma);
+    else
+      proxies[u] = make_proxy_cells(serial, grouped, sigma[u] / cells_per_sigma);
+    for (std::size_t i = 0; i < P; ++i) cell_of[u][i] = proxies[u].cell_of[u == 0 ? proxies[0].order[i] : cell_of[u - 1][i]];
   }
   // Blend: points in cell order (so that neighbouring points read neighbouring proxies), each
   // proxy's position and average side by side.
   // The σ run in parallel, each serially: a proxy's kernel is small, and 8 parallel phases per σ
-  // cost more than they gain when other processes share the cores (OpenMP barriers).
+  // cost more than they gain when other processes share the cores (OpenMP barriers). A single σ
+  // (the weighting map's smoothing) runs its kernel through exec.
   std::vector<std::vector<std::array<double, 4>>> at_proxy(L);
-  exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t u = b; u < e; ++u) {
-      const vertex_points& q = proxies[u].points;
-      // Columns one ball wide: a proxy has about (4·cells_per_sigma)² neighbours in a ball, too
-      // few for the exact kernel's narrower columns to pay for their overhead (3x slower at 2
-      // cells per σ).
-      serial_executor serial;
-      const std::vector<double> a = exact_gaussian_averages(serial, q, {sigma[u]}, grain, 1.0);
-      at_proxy[u].resize(a.size());
-      for (std::size_t i = 0; i < a.size(); ++i) at_proxy[u][i] = {q.x[i], q.y[i], q.z[i], a[i]};
-    }
-  });
+  auto kernel = [&](auto& ex, std::size_t u) {
+    const vertex_points& q = proxies[u].points;
+    // Columns one ball wide: a proxy has about (4·cells_per_sigma)² neighbours in a ball, too
+    // few for the exact kernel's narrower columns to pay for their overhead (3x slower at 2
+    // cells per σ).
+    const std::vector<double> a = exact_gaussian_averages(ex, q, {sigma[u]}, grain, 1.0);
+    at_proxy[u].resize(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) at_proxy[u][i] = {q.x[i], q.y[i], q.z[i], a[i]};
+  };
+  if (L == 1) {
+    kernel(exec, 0);
+  } else {
+    exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
+      serial_executor one;
+      for (std::size_t u = b; u < e; ++u) kernel(one, u);
+    });
+  }
   const std::vector<std::uint32_t>& order = proxies[0].order;
   std::vector<double> sx(P), sy(P), sz(P);
   for (std::size_t i = 0; i < P; ++i) sx[i] = pts.x[order[i]], sy[i] = pts.y[order[i]], sz[i] = pts.z[order[i]];
