@@ -1,7 +1,7 @@
 // libFuzzer target: every option of the LOD family at fuzzed values, extremes included
 // (weighting_map_options, simplification_options, view_dependent_lod's lambda_perc and grain,
 // the frame's camera and global contraction count), on small fuzzed meshes.
-// Input: [flags][weighting options][simplification options][lambda_perc][grain][camera position x3,
+// Input: [flags (16: proxy smoothing)][weighting options][simplification options][lambda_perc][grain][camera position x3,
 // looking at the origin]
 // [contractions][mesh][per-vertex saliency][cluster per triangle].
 // Checks: every error names its problem; weights are finite and >= 0; a frame's index buffer fits
@@ -18,9 +18,10 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   fuzz::reader r{data, size};
   const std::uint8_t flags = r.u8();
-  const infolerp::weighting_map_options wo{.epsilon = r.real(), .smoothing_scale = r.real(),
-                                           .amplify_percentile = r.real() * 20.0, .amplification = r.real(),
-                                           .grain = r.count<std::size_t>()};
+  infolerp::weighting_map_options wo{.epsilon = r.real(), .smoothing_scale = r.real(),
+                                     .amplify_percentile = r.real() * 20.0, .amplification = r.real(),
+                                     .grain = r.count<std::size_t>()};
+  if (flags & 16) wo.smoothing_method = infolerp::saliency_method::proxy;  // the proxy smoothing at any size
   const infolerp::simplification_options so{.backstop = r.real(), .boundary_weight = r.real(),
                                             .min_normal_cos = r.real(), .cluster_local_first = (flags & 1) != 0};
   const double lambda_perc = r.real();
