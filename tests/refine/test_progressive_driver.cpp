@@ -475,8 +475,15 @@ TEST_CASE("criteria: NLD_IS recursion equals a brute-force walk of every quadran
   auto r = make_refiner(m, {.criteria = {.criterion = refinement_criterion::nld_os, .s_req = 0.01f, .min_pixels = 2.0f, .batch = 3}});
   REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
   for (int b = 0; b < 4; ++b) r.refine(shade, refine_budget{.batches = 1});
-  r.refine(refine_budget{.batches = 1});  // one more batch, its requests left outstanding: the luminance image is the one it read
-  const refinement_frame f = r.frame();
+  r.refine(refine_budget{.batches = 1});  // one more batch, its requests left outstanding
+  // An NLD_OS refiner keeps no luminance image (it reads L_max only): the image's, computed here.
+  std::vector<glm::vec3> img(23u * 17u);
+  r.reconstruct(img);
+  std::vector<float> pixel_luminance(img.size());
+  std::transform(img.begin(), img.end(), pixel_luminance.begin(), [](glm::vec3 c) { return luminance(c); });
+  refinement_frame f = r.frame();
+  CHECK(f.pixel_luminance.empty());
+  f.pixel_luminance = pixel_luminance;
   REQUIRE(f.pixel_luminance.size() == 23u * 17u);
   REQUIRE(f.projection != nullptr);
   std::size_t nonempty = 0, exhaustive = 0;

@@ -37,6 +37,7 @@
 // glm::vec3 shade(const shading_point&) is called once per request, concurrently.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
@@ -181,8 +182,9 @@ class progressive_refiner {
   // nld_os_queue.hpp; NLD_IS and RND: criteria.hpp) + O(R) splits + O(new triangles · log)
   // (finding the split leaves) + O(pixels of the split leaves · level) for the re-location +
   // O(subtrees under the split leaves' parents) for the shown cut + O(pixels whose shown
-  // triangle changed + max-tree nodes that changed); the view's first batch also builds its
-  // luminance image, O(pixels).
+  // triangle changed + max-tree nodes that changed) for NLD_IS, O(leaves whose shown triangle
+  // changed · log + leaves evaluated for L_max · their pixels) for the others; the view's first
+  // batch also builds NLD_IS's luminance image, O(pixels), or the others' bounds, O(visible).
   template <class E = serial_executor>
   refine_progress refine(refine_budget budget = {}, E&& exec = E{}) {
     return refine_impl(exec, budget, [](auto&) {});
@@ -382,8 +384,7 @@ class progressive_refiner {
       record_stage1();
       if (finished_) return b == 0 ? refine_progress::finished : refine_progress::refined;
       if (cache_full()) return b == 0 ? refine_progress::cache_full : refine_progress::refined;
-      lum_.update(view_.pixel_leaf().size(), exec, options_.grain, [&](std::size_t p) { return luminance(pixel_colour(p)); },
-                  [&](std::uint32_t leaf, auto&& f) { view_.for_each_pixel(leaf, f); });
+      update_luminance(exec);
       selected_.clear();
       const refinement_frame f = frame();
       select_for_refinement(f, options_.criteria, state_, selected_, [&](std::vector<std::uint32_t>& ids, std::size_t limit) {
@@ -403,6 +404,33 @@ class progressive_refiner {
       report_.stage2 = figures();
     }
     return refine_progress::refined;
+  }
+
+  // L_max (and for NLD_IS, the only criterion that reads them, the pixel luminances) brought up
+  // to date. Without the image, a visible leaf's pixels are bounded by its shown triangle's
+  // brightest corner: luminance grows with each channel and pixel_colour() clamps to the corners.
+  template <class E>
+  void update_luminance(E& exec) {
+    if (options_.criteria.criterion == refinement_criterion::nld_is)
+      return lum_.update(view_.pixel_leaf().size(), exec, options_.grain, [&](std::size_t p) { return luminance(pixel_colour(p)); },
+                         [&](std::uint32_t leaf, auto&& f) { view_.for_each_pixel(leaf, f); });
+    const float background = luminance(options_.background), none = -std::numeric_limits<float>::infinity();
+    const std::span<const glm::vec3> colour = cache_.colours();
+    const auto bound = [&](std::uint32_t leaf) {
+      if (view_.leaf_pixels()[leaf] == 0 || !view_.visible().contains(leaf)) return none;
+      const std::uint32_t d = cut_.display_of(leaf);
+      if (d == invalid_id) return background;
+      const glm::uvec3 v = mesh_.triangle(d).vertices;
+      const float b = luminance(glm::max(colour[v.x], glm::max(colour[v.y], colour[v.z])));
+      return b + std::abs(b) * 0x1p-20f + 0x1p-126f;  // a margin for the rounding of the interpolation
+    };
+    const auto exact = [&](std::uint32_t leaf) {
+      if (cut_.display_of(leaf) == invalid_id) return background;
+      float m = none;
+      view_.for_each_pixel(leaf, [&](std::uint32_t p) { m = std::max(m, luminance(pixel_colour(p))); });
+      return m;
+    };
+    lum_.update_bounds(view_.visible().unordered(), view_missed_ ? background : 0.0f, bound, exact);
   }
 
   [[nodiscard]] glm::vec3 pixel_colour(std::size_t p) const {
@@ -452,6 +480,7 @@ class progressive_refiner {
   void view_leaves(const std::vector<hit>& hits, E&& exec) {
     grow();
     view_.locate(mesh_, hits, exec, options_.grain);
+    view_missed_ = std::find(view_.pixel_leaf().begin(), view_.pixel_leaf().end(), invalid_id) != view_.pixel_leaf().end();
     nld_os_.clear();
     if (options_.criteria.criterion == refinement_criterion::nld_os)
       for (std::uint32_t t : view_.fresh()) nld_os_.add(t);
@@ -508,6 +537,7 @@ class progressive_refiner {
     cut_.begin_update();
     for (std::uint32_t t : view_.split()) {
       cut_.set_display(t, invalid_id, lum_);  // no longer a visible leaf
+      lum_.mark_dirty(t);                     // (also when nothing was shown over it)
       cut_.seed(mesh_, t);
       view_.relocate(mesh_, t);
     }
@@ -542,6 +572,7 @@ class progressive_refiner {
   std::uint32_t width_ = 0, height_ = 0;
   pinhole_frame projection_;     // the view's camera, when it is a pinhole one (NLD_IS's projected areas)
   bool has_projection_ = false;
+  bool view_missed_ = false;     // a pixel of the view missed the scene (shows the background)
   detail::view_pixels view_;              // pixels located in the hierarchy, the visible leaves
   detail::shading_cache cache_;           // per-vertex colours and requests
   detail::shown_cut cut_;                 // the shown set and its deltas
