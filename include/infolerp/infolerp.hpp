@@ -61,4 +61,5 @@
 #include "infolerp/mesh/support_function.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/random.hpp"
+#include "infolerp/core/unit_vector.hpp"
 #include "infolerp/core/large_buffer.hpp"

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include "infolerp/core/mesh_traits.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/core/tracer.hpp"
+#include "infolerp/core/unit_vector.hpp"
 #include "infolerp/mesh/adaptors.hpp"
 #include "support/thread_pool.hpp"
 
@@ -223,4 +225,24 @@ TEST_CASE("group_by_key: stable CSR buckets, empty buckets, skipped items, reuse
       3, 0, [](std::size_t) { return 0u; }, [](std::size_t) { return 0u; }, offsets, grouped);
   CHECK(offsets == std::vector<std::uint32_t>{0, 0, 0, 0});
   CHECK(grouped.empty());
+}
+
+TEMPLATE_TEST_CASE("unit_or_zero: glm::normalize's bits for ordinary vectors, unit length at any finite scale, zero otherwise",
+                   "", float, double) {
+  using v3 = glm::vec<3, TestType>;
+  using lim = std::numeric_limits<TestType>;
+  const v3 d(TestType(3), TestType(-4), TestType(12));
+  CHECK(infolerp::unit_or_zero(d) == glm::normalize(d));
+  // Scales whose squared length overflows, underflows or is subnormal: the direction survives.
+  for (const TestType s : {lim::max() / TestType(16), std::sqrt(lim::max()) * TestType(4), std::sqrt(lim::min()),
+                           lim::min(), lim::denorm_min() * TestType(13)}) {
+    const v3 u = infolerp::unit_or_zero(d * s / TestType(13));
+    INFO("scale " << s);
+    CHECK(std::abs(glm::length(u) - TestType(1)) < TestType(8) * lim::epsilon());
+    CHECK(glm::length(u - glm::normalize(d)) < TestType(0.05));  // subnormals keep few digits
+  }
+  CHECK(infolerp::unit_or_zero(v3(TestType(0))) == v3(TestType(0)));
+  CHECK(infolerp::unit_or_zero(v3(lim::quiet_NaN(), TestType(1), TestType(0))) == v3(TestType(0)));
+  CHECK(infolerp::unit_or_zero(v3(TestType(1), lim::quiet_NaN(), TestType(0))) == v3(TestType(0)));
+  CHECK(infolerp::unit_or_zero(v3(lim::infinity(), TestType(1), TestType(0))) == v3(TestType(0)));
 }

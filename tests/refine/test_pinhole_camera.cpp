@@ -16,7 +16,7 @@ namespace {
 // tan() recomputed for every pixel.
 ray oracle_ray(const pinhole_camera& c, std::uint32_t x, std::uint32_t y) {
   const glm::vec3 f = pinhole_camera::forward(c.eye, c.target);
-  const glm::vec3 r = pinhole_camera::unit(glm::cross(f, c.up));
+  const glm::vec3 r = unit_or_zero(glm::cross(f, c.up));
   const glm::vec3 u = glm::cross(r, f);
   const float h = std::tan(glm::radians(c.vertical_fov_degrees) * 0.5f);
   const float aspect = float(c.width) / float(c.height);
@@ -40,7 +40,7 @@ TEST_CASE("pinhole_camera: the frame's rays equal the per-ray formula within 1e-
     pinhole_camera c{.eye = {pos(rng), pos(rng), pos(rng)}, .target = {pos(rng), pos(rng), pos(rng)},
                      .up = {pos(rng), pos(rng), pos(rng)}, .vertical_fov_degrees = fov(rng), .width = size(rng),
                      .height = size(rng)};
-    if (glm::length(glm::cross(pinhole_camera::forward(c.eye, c.target), pinhole_camera::unit(c.up))) < 1e-3f) continue;
+    if (glm::length(glm::cross(pinhole_camera::forward(c.eye, c.target), unit_or_zero(c.up))) < 1e-3f) continue;
     const pinhole_frame fr = c.frame();
     for (std::uint32_t k = 0; k < 50; ++k) {
       const std::uint32_t x = std::uniform_int_distribution<std::uint32_t>(0, c.width - 1)(rng);

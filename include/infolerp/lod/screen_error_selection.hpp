@@ -41,6 +41,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/status.hpp"
+#include "infolerp/core/unit_vector.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
 #include "infolerp/lod/view_selection.hpp"
 #include "infolerp/saliency/cluster_importance.hpp"
@@ -62,13 +63,6 @@ struct view_weight_options {
   double near_fraction = 0.1;      // nearest distance, as a fraction of the cluster radius, > 0
 };
 
-// v divided by its largest absolute component (v itself when 0), so that lengths and cross
-// products of any finite vector neither overflow nor underflow. O(1).
-inline glm::dvec3 scaled_for_length(const glm::dvec3& v) {
-  const double m = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-  return m > 0.0 ? v / m : v;
-}
-
 // Errors: a non-finite field, a zero forward vector, up parallel to forward, fov outside (0, π)
 // (bad_parameter, each named); a zero-size viewport (bad_size). Any finite length of forward and
 // up is fine (they are scaled before they are normalised). O(1).
@@ -76,10 +70,10 @@ inline status check_camera(const lod_camera& cam) {
   if (!all_finite(cam.position)) return make_error(errc::bad_parameter, no_element, "camera position is not finite");
   if (!all_finite(cam.forward) || !all_finite(cam.up))
     return make_error(errc::bad_parameter, no_element, "camera forward or up vector is not finite");
-  const glm::dvec3 f = scaled_for_length(cam.forward), u = scaled_for_length(cam.up);
-  if (!(glm::length(f) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera forward vector is zero");
-  if (!(glm::length(u) > 0.0)) return make_error(errc::bad_parameter, no_element, "camera up vector is zero");
-  if (!(glm::length(glm::cross(f, u)) > 1e-12 * glm::length(f) * glm::length(u)))
+  const glm::dvec3 f = unit_or_zero(cam.forward), u = unit_or_zero(cam.up);
+  if (f == glm::dvec3(0.0)) return make_error(errc::bad_parameter, no_element, "camera forward vector is zero");
+  if (u == glm::dvec3(0.0)) return make_error(errc::bad_parameter, no_element, "camera up vector is zero");
+  if (!(glm::length(glm::cross(f, u)) > 1e-12))
     return make_error(errc::bad_parameter, no_element, "camera up vector is parallel to forward");
   if (!(cam.vertical_fov > 0.0 && cam.vertical_fov < std::numbers::pi))
     return make_error(errc::bad_parameter, no_element, "camera vertical_fov ", cam.vertical_fov, " must be in (0, pi)");
@@ -93,8 +87,8 @@ struct camera_basis {
   glm::dvec3 forward, right, up;
 };
 inline camera_basis make_camera_basis(const lod_camera& cam) {
-  const glm::dvec3 f = glm::normalize(scaled_for_length(cam.forward));
-  const glm::dvec3 right = glm::normalize(glm::cross(f, scaled_for_length(cam.up)));
+  const glm::dvec3 f = unit_or_zero(cam.forward);
+  const glm::dvec3 right = unit_or_zero(glm::cross(f, unit_or_zero(cam.up)));
   return {f, right, glm::cross(right, f)};
 }
 

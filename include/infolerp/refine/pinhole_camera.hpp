@@ -13,6 +13,7 @@
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 #include "infolerp/core/tracer.hpp"
+#include "infolerp/core/unit_vector.hpp"
 
 namespace infolerp {
 
@@ -70,24 +71,15 @@ struct pinhole_camera {
   std::uint32_t width = 320;           // image width in pixels
   std::uint32_t height = 240;          // image height in pixels
 
-  // d / |d|: glm::normalize where the squared length is a normal float (so ordinary cameras keep
-  // their bits), scaled by the largest component first where it over- or underflows; (0,0,0)
-  // for a zero or non-finite d.
-  [[nodiscard]] static glm::vec3 unit(const glm::vec3& d) {
-    const float l2 = glm::dot(d, d);
-    if (std::isfinite(l2) && l2 >= std::numeric_limits<float>::min()) return glm::normalize(d);
-    const float scale = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-    return scale > 0.0f && std::isfinite(scale) ? glm::normalize(d / scale) : glm::vec3(0.0f);
-  }
   // The unit view direction; (0,0,0) when eye and target coincide or target - eye overflows.
-  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) { return unit(target - eye); }
+  [[nodiscard]] static glm::vec3 forward(const glm::vec3& eye, const glm::vec3& target) { return unit_or_zero(target - eye); }
 
   // The frame: one tan and the basis. O(1).
   [[nodiscard]] pinhole_frame frame() const {
     pinhole_frame fr;
     fr.eye = eye;
     fr.forward = forward(eye, target);
-    fr.right = unit(glm::cross(fr.forward, up));
+    fr.right = unit_or_zero(glm::cross(fr.forward, up));
     fr.up = glm::cross(fr.right, fr.forward);
     fr.tan_half_fov = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
     fr.aspect = float(width) / float(height);

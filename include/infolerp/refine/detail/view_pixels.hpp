@@ -44,7 +44,7 @@ status check_camera(const Camera& camera) {
     const glm::vec3 f = pinhole_camera::forward(e, t);
     if (f == glm::vec3(0.0f))
       return make_error(errc::bad_parameter, no_element, "camera eye and target are too far apart: target - eye overflows float");
-    if (!(glm::length(glm::cross(f, pinhole_camera::unit(u))) > 1e-6f))
+    if (!(glm::length(glm::cross(f, unit_or_zero(u))) > 1e-6f))
       return make_error(errc::bad_parameter, no_element, "camera up is zero or parallel to the view direction");
     const float fov = camera.vertical_fov_degrees;
     if (!(fov > 0.0f && fov < 180.0f))
