@@ -30,9 +30,9 @@
 //    because its corners fall on other triangles (a silhouette, a neighbour across a shadow
 //    edge). As §4.1's large-triangle rule does for NLD_OS, triangles covering more than
 //    `always_refine_fraction` of the image are exempt, so a feature that no vertex sees yet is
-//    still looked for inside large triangles. (Skipping them cut NLD_IS's samples to the same
-//    final image by more than half on the street scene: benchmarks/NOTES.md.) For an sRGB
-//    display the darkest steps are 12.92 times finer: pass a smaller quantum there.
+//    still looked for inside large triangles; in smaller ones it is left unfound, as NLD_OS
+//    leaves it. For an sRGB display the darkest steps are 12.92 times finer: pass a smaller
+//    quantum there. 0 turns the rule off (the paper's NLD_IS).
 //  - No criterion selects a triangle whose split would give children with coinciding float
 //    corners (subdivision_mesh::splittable).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
