@@ -1,4 +1,4 @@
-// infolerp_pareto refine --csv FILE [--png FILE] [--width W --height H] [--s-req S]
+// infolerp_pareto refine --csv FILE [--png FILE] [--width W --height H] [--s-req S] [--display-quantum Q]
 //
 // The experiment of Oliveira, Santos, Proença (§5, §6, Table 1) on a procedural walkthrough
 // scene: a street with a portico (a row of columns under a roof slab), a long wall behind it and
@@ -9,6 +9,7 @@
 //
 // CSV: criterion,stage,shading_samples,triangles,triangles_total,seconds,psnr_db
 // (stage 1: initial geometry shaded; stage 2: refinement stopped by the budget or the rule).
+// --display-quantum sets NLD_IS's criteria_options::display_quantum (0: the paper's NLD_IS).
 // seconds is wall time per run; benchmarks/results/refine.csv was made with OMP_NUM_THREADS=1
 // (with two OpenMP threads on the shared 2-core machine it varied 5-20x with the other load;
 // every other column is the same for any thread count).
@@ -57,7 +58,7 @@ struct run_result {
 
 template <class E>
 run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::vector<glm::vec3>& reference,
-               infolerp::refinement_criterion criterion, std::size_t budget, float s_req, E& exec,
+               infolerp::refinement_criterion criterion, std::size_t budget, float s_req, float quantum, E& exec,
                float rnd_fraction = 1.0f, float random_share = 0.0f) {
   auto sub = infolerp::subdivision_mesh::create(sc.mesh);
   if (!sub.ok()) {
@@ -71,8 +72,13 @@ run_result run(const scene& sc, const infolerp::pinhole_camera& cam, const std::
   o.criteria.always_refine_fraction = 0.02f;
   o.criteria.rnd_point_fraction = rnd_fraction;
   o.criteria.random_share = random_share;
+  o.criteria.display_quantum = quantum;
   o.max_shading_samples = budget;
   auto r = infolerp::progressive_refiner::create(std::move(*sub), o);
+  if (!r.ok()) {
+    std::fprintf(stderr, "%s\n", r.error().message().c_str());
+    std::exit(1);
+  }
   const auto shade = [&](const infolerp::shading_point& sp) { return sc.shade(sp.position, sp.triangle); };
   run_result out;
   const std::size_t n = std::size_t(cam.width) * cam.height;
@@ -98,6 +104,7 @@ int pareto_refine(int argc, char** argv) {
   std::string csv_path = "refine.csv", png_path;
   std::uint32_t width = 320, height = 240;
   float s_req = 0.05f;  // S_req for NLD_OS and NLD_IS (the paper does not give its value)
+  float quantum = infolerp::criteria_options{}.display_quantum;
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
@@ -105,8 +112,10 @@ int pareto_refine(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--width")) width = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--height")) height = static_cast<std::uint32_t>(std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--s-req")) s_req = static_cast<float>(std::atof(next().c_str()));
+    else if (!std::strcmp(argv[i], "--display-quantum")) quantum = static_cast<float>(std::atof(next().c_str()));
     else {
-      std::fprintf(stderr, "usage: infolerp_pareto refine --csv FILE [--png FILE] [--width W] [--height H] [--s-req S]\n");
+      std::fprintf(stderr, "usage: infolerp_pareto refine --csv FILE [--png FILE] [--width W] [--height H] [--s-req S] "
+                           "[--display-quantum Q]\n");
       return 2;
     }
   }
@@ -154,7 +163,7 @@ int pareto_refine(int argc, char** argv) {
     const char* name = infolerp::to_string(criteria[c]);
     bool first = true;
     for (std::size_t budget : budgets) {
-      run_result rr = run(sc, cam, reference, criteria[c], budget, s_req, exec);
+      run_result rr = run(sc, cam, reference, criteria[c], budget, s_req, quantum, exec);
       const auto& s1 = rr.report.stage1;
       const auto& s2 = rr.report.stage2;
       if (first) {
@@ -180,14 +189,14 @@ int pareto_refine(int argc, char** argv) {
   // NLD_OS run to budgets 25 samples apart: its PSNR against shading samples.
   std::vector<std::pair<std::size_t, double>> os_fine;
   for (std::size_t budget = 25;; budget += 25) {
-    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_os, budget, s_req, exec);
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_os, budget, s_req, quantum, exec);
     os_fine.push_back({rr.report.stage2.shading_samples, rr.psnr2});
     if (!rr.report.budget_reached) break;
   }
   // NLD_IS the same way (its walk to pixel size costs more per batch: the run is longer).
   std::vector<std::pair<std::size_t, double>> is_fine;
   for (std::size_t budget = 25;; budget += 25) {
-    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_is, budget, s_req, exec);
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::nld_is, budget, s_req, quantum, exec);
     is_fine.push_back({rr.report.stage2.shading_samples, rr.psnr2});
     if (!rr.report.budget_reached) break;
   }
@@ -256,7 +265,7 @@ int pareto_refine(int argc, char** argv) {
   std::printf("RND point fraction sweep (NLD_OS samples to reach RND's final PSNR, goal <= 25%%):\n");
   std::printf("%10s %12s %10s %14s %8s\n", "fraction", "RND samples", "RND dB", "NLD_OS samples", "ratio");
   for (float fraction : {0.05f, 0.1f, 0.2f, 0.3f, 0.5f, 0.75f, 1.0f}) {
-    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::rnd, unlimited, s_req, exec, fraction);
+    const run_result rr = run(sc, cam, reference, infolerp::refinement_criterion::rnd, unlimited, s_req, quantum, exec, fraction);
     const std::size_t rs = rr.report.stage2.shading_samples;
     const auto reach = std::find_if(os_fine.begin(), os_fine.end(), [&](const auto& p) { return p.second >= rr.psnr2; });
     if (reach == os_fine.end())
@@ -274,7 +283,7 @@ int pareto_refine(int argc, char** argv) {
   for (float share : {0.125f, 0.25f, 0.5f})
     for (float fraction : {0.1f, 0.3f}) {
       const run_result rr =
-          run(sc, cam, reference, infolerp::refinement_criterion::nld_os, unlimited, s_req, exec, fraction, share);
+          run(sc, cam, reference, infolerp::refinement_criterion::nld_os, unlimited, s_req, quantum, exec, fraction, share);
       std::printf("%8.3f %10.2f %12zu %10.2f %+16.2f\n", double(share), double(fraction),
                   rr.report.stage2.shading_samples, rr.psnr2, rr.psnr2 - os_psnr);
     }

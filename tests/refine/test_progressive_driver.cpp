@@ -357,6 +357,13 @@ TEST_CASE("driver: options and cameras at their extremes get a status naming the
     CHECK(progressive_refiner::create(*s, {.criteria = {.always_refine_fraction = bad}}).error().code() == errc::bad_parameter);
     CHECK(progressive_refiner::create(*s, {.criteria = {.nld_is_pixel_fraction = bad}}).error().code() == errc::bad_parameter);
   }
+  for (float bad : {nan, -1.0f, std::numeric_limits<float>::infinity()}) {
+    auto r = progressive_refiner::create(*s, {.criteria = {.display_quantum = bad}});
+    REQUIRE(!r.ok());
+    CHECK(r.error().code() == errc::bad_parameter);
+    CHECK(r.error().message().find("display_quantum") != std::string::npos);
+  }
+  CHECK(progressive_refiner::create(*s, {.criteria = {.display_quantum = 0.0f}}).ok());
   // A 0xffffffff x 0xffffffff image passes every camera check but no allocation can hold it.
   auto r = make_refiner(m, {});
   auto shade = [](const shading_point&) { return glm::vec3(1.0f); };
@@ -424,9 +431,12 @@ namespace {
 
 // NLD_IS by brute force: every quadrant of the image quadtree down to one pixel in a plain list,
 // the next one taken by a linear scan for the largest S (ties: smaller y0, then x0), the
-// triangle under its centre selected when S > S_req, its area (oracle_area) reaches min_pixels
-// and it is not selected already. Up to `batch` ids.
-std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const criteria_options& o, const pinhole_camera& cam) {
+// triangle under its centre selected when S > S_req, its area (oracle_area) reaches min_pixels,
+// it is not selected already and its corners' colours (read from the refiner) differ by
+// display_quantum or more in some channel unless it covers more than always_refine_fraction of
+// the pixels (counted here). Up to `batch` ids.
+std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const criteria_options& o, const pinhole_camera& cam,
+                                              const progressive_refiner& r) {
   struct quad {
     float s;
     std::uint32_t x0, y0, x1, y1;
@@ -455,7 +465,15 @@ std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const c
     const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
     if (q.s > o.s_req && leaf != invalid_id && std::find(out.begin(), out.end(), leaf) == out.end()) {
       const glm::uvec3 v = f.mesh->triangle(leaf).vertices;
-      if (oracle_area(cam, f.mesh->position(v.x), f.mesh->position(v.y), f.mesh->position(v.z)) >= double(o.min_pixels))
+      const bool big = double(std::count(f.pixel_leaf.begin(), f.pixel_leaf.end(), leaf)) >
+                       double(o.always_refine_fraction) * double(f.width) * double(f.height);
+      bool differ = false;
+      for (int ch = 0; ch < 3; ++ch) {
+        const float c[3] = {r.vertex_colour(v.x)[ch], r.vertex_colour(v.y)[ch], r.vertex_colour(v.z)[ch]};
+        differ |= *std::max_element(c, c + 3) - *std::min_element(c, c + 3) >= o.display_quantum;
+      }
+      if (oracle_area(cam, f.mesh->position(v.x), f.mesh->position(v.y), f.mesh->position(v.z)) >= double(o.min_pixels) &&
+          (differ || big))
         out.push_back(leaf);
     }
     if (q.x1 - q.x0 > 1 || q.y1 - q.y0 > 1) split(q);
@@ -486,23 +504,76 @@ TEST_CASE("criteria: NLD_IS recursion equals a brute-force walk of every quadran
   f.pixel_luminance = pixel_luminance;
   REQUIRE(f.pixel_luminance.size() == 23u * 17u);
   REQUIRE(f.projection != nullptr);
-  std::size_t nonempty = 0, exhaustive = 0;
+  REQUIRE(f.vertex_colour.size() == r.mesh().vertex_count());
+  std::size_t nonempty = 0, exhaustive = 0, quantum_mattered = 0;
   for (float s_req : {0.0f, 0.02f, 0.1f, 0.3f})
     for (float min_pixels : {0.0f, 1.0f, 6.0f, 40.0f})
       for (std::uint32_t batch : {1u, 4u, 1000u}) {
-        const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = s_req, .min_pixels = min_pixels, .batch = batch};
-        std::vector<std::uint32_t> got{7u};  // what the caller's vector held stays
-        select_nld_is(f, o, got);
-        REQUIRE(got.front() == 7u);
-        got.erase(got.begin());
-        const std::vector<std::uint32_t> want = nld_is_brute_force(f, o, cam);
-        INFO("s_req " << s_req << ", min_pixels " << min_pixels << ", batch " << batch);
-        CHECK(got == want);
-        nonempty += !want.empty();
-        exhaustive += batch == 1000u && want.size() > 4;  // fewer than R: the walk went to pixel size
+        std::vector<std::uint32_t> without_rule;
+        for (float quantum : {0.0f, 0.5f / 255.0f, 0.05f})
+          for (float large : {0.02f, 0.2f}) {
+            const criteria_options o{.criterion = refinement_criterion::nld_is, .s_req = s_req, .min_pixels = min_pixels,
+                                     .always_refine_fraction = large, .batch = batch, .display_quantum = quantum};
+            std::vector<std::uint32_t> got{7u};  // what the caller's vector held stays
+            select_nld_is(f, o, got);
+            REQUIRE(got.front() == 7u);
+            got.erase(got.begin());
+            const std::vector<std::uint32_t> want = nld_is_brute_force(f, o, cam, r);
+            INFO("s_req " << s_req << ", min_pixels " << min_pixels << ", batch " << batch << ", display_quantum " << quantum
+                          << ", always_refine_fraction " << large);
+            CHECK(got == want);
+            if (quantum == 0.0f && large == 0.02f) without_rule = want;
+            quantum_mattered += want != without_rule;
+            nonempty += !want.empty();
+            exhaustive += batch == 1000u && want.size() > 4;  // fewer than R: the walk went to pixel size
+          }
       }
-  CHECK(nonempty >= 20);  // the comparison selected something in most settings
-  CHECK(exhaustive >= 2);
+  CHECK(nonempty >= 120);  // the comparison selected something in most settings
+  CHECK(exhaustive >= 12);
+  CHECK(quantum_mattered >= 10);  // the display rule and its large-triangle exemption changed selections
+}
+
+TEST_CASE("driver: NLD_IS does not split a triangle whose corners show one value unless it is large") {
+  // The floor's two triangles are lit alike at every corner; a shadow strip (0.1 < x < 0.4)
+  // misses them all. The quadrants across the floor's silhouette have S > S_req, and the
+  // triangle under their centres is split only when the display rule is off or the triangle
+  // counts as large.
+  const auto m = floor_mesh();
+  const auto cam = top_camera();
+  const auto strip = [](glm::vec3 p) { return p.x > 0.1f && p.x < 0.4f ? glm::vec3(0.05f) : glm::vec3(0.9f, 0.8f, 0.7f); };
+  const auto ref = reference(m, cam, strip);
+  auto shade = [&](const shading_point& sp) { return strip(sp.position); };
+  const auto run = [&](float quantum, float large) {
+    auto r = make_refiner(m, {.criteria = {.criterion = refinement_criterion::nld_is, .always_refine_fraction = large,
+                                           .batch = 16, .display_quantum = quantum}});
+    REQUIRE(r.run(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+    return r;
+  };
+  const auto flat = run(0.5f / 255.0f, 1.0f);  // nothing covers more than the whole image
+  CHECK(flat.report().selections == 0);
+  const auto off = run(0.0f, 1.0f), exempt = run(0.5f / 255.0f, 0.02f);
+  CHECK(off.report().selections > 0);
+  CHECK(exempt.report().selections > 0);
+  CHECK(psnr(image_of(exempt, cam), ref) > psnr(image_of(flat, cam), ref));
+  // Along the exempt run every split triangle below the large size has corners that differ.
+  auto r = make_refiner(m, {.criteria = {.criterion = refinement_criterion::nld_is, .always_refine_fraction = 0.02f, .batch = 4}});
+  REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+  std::size_t checked = 0;
+  for (int b = 0; b < 400; ++b) {
+    std::vector<std::uint32_t> covered(r.mesh().triangle_count(), 0);  // pixels per leaf before the batch
+    for (std::uint32_t leaf : r.pixel_leaves())
+      if (leaf != invalid_id) ++covered[leaf];
+    if (!r.refine_batch(shade)) break;
+    for (std::uint32_t t : r.last_selection()) {
+      if (double(covered[t]) > 0.02 * 64.0 * 64.0) continue;
+      const glm::uvec3 v = r.mesh().triangle(t).vertices;
+      const glm::vec3 lo = glm::min(r.vertex_colour(v.x), glm::min(r.vertex_colour(v.y), r.vertex_colour(v.z)));
+      const glm::vec3 hi = glm::max(r.vertex_colour(v.x), glm::max(r.vertex_colour(v.y), r.vertex_colour(v.z)));
+      CHECK(std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z)) >= 0.5f / 255.0f);
+      ++checked;
+    }
+  }
+  CHECK(checked > 0);
 }
 
 TEST_CASE("driver: NLD_IS at s_req 0 and min_pixels 1 ends by itself, colours inside what was delivered") {

@@ -486,6 +486,11 @@ std::vector<option_row> refine_rows() {
          c.criterion = refinement_criterion::rnd;
          c.rnd_point_fraction = as_float(x);
        })},
+      {"progressive_refiner", "display_quantum", true, 0, {},
+       crit([](criteria_options& c, double x) {
+         c.criterion = refinement_criterion::nld_is;
+         c.display_quantum = as_float(x);
+       })},
       {"progressive_refiner", "random_share", true, 0, {1.0000001},
        crit([](criteria_options& c, double x) { c.random_share = as_float(x); })},
       {"progressive_refiner", "seed", false, u64_max, {},

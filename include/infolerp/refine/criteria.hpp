@@ -24,6 +24,15 @@
 //    current view reach `nld_is_pixel_fraction` of the pixel count (checked per batch, so the
 //    last batch may overshoot by its own requests; the paper gives no value, so the default is
 //    none).
+//  - NLD_IS does not split a triangle whose corner colours differ by less than
+//    `display_quantum` in every channel (default half a step of an 8-bit display of values in
+//    [0, 1]): its interpolation shows one displayed value, and a quadrant's S is high there only
+//    because its corners fall on other triangles (a silhouette, a neighbour across a shadow
+//    edge). As §4.1's large-triangle rule does for NLD_OS, triangles covering more than
+//    `always_refine_fraction` of the image are exempt, so a feature that no vertex sees yet is
+//    still looked for inside large triangles; in smaller ones it is left unfound, as NLD_OS
+//    leaves it. For an sRGB display the darkest steps are 12.92 times finer: pass a smaller
+//    quantum there. 0 turns the rule off (the paper's NLD_IS).
 //  - No criterion selects a triangle whose split would give children with coinciding float
 //    corners (subdivision_mesh::splittable).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
@@ -41,6 +50,8 @@
 #include <queue>
 #include <span>
 #include <vector>
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
 #include "infolerp/core/random.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/refine/nld.hpp"
@@ -69,6 +80,7 @@ struct criteria_options {
   float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count, in [0, max_rnd_point_fraction]
   float nld_is_pixel_fraction = std::numeric_limits<float>::infinity();  // NLD_IS: stop once the view's requests reach this fraction of the pixels
   float random_share = 0.0f;             // NLD_OS: share of each batch given to a random pass (0: none)
+  float display_quantum = 0.5f / 255.0f; // NLD_IS: skip triangles whose corners agree within this in every channel (0: none)
   std::uint64_t seed = 1;                // RND: random sequence
 
   // Largest rnd_point_fraction: a million draws per pixel, far past where RND finds anything new,
@@ -92,6 +104,9 @@ inline status validate(const criteria_options& o) {
   if (!(o.rnd_point_fraction >= 0.0f && o.rnd_point_fraction <= criteria_options::max_rnd_point_fraction))
     return make_error(errc::bad_parameter, no_element, "criteria_options.rnd_point_fraction ", o.rnd_point_fraction,
                       " outside [0, ", criteria_options::max_rnd_point_fraction, "]");
+  if (!(o.display_quantum >= 0.0f && std::isfinite(o.display_quantum)))
+    return make_error(errc::bad_parameter, no_element, "criteria_options.display_quantum ", o.display_quantum,
+                      " must be finite and >= 0");
   if (!(o.random_share >= 0.0f && o.random_share <= 1.0f))
     return make_error(errc::bad_parameter, no_element, "criteria_options.random_share ", o.random_share, " outside [0, 1]");
   return {};
@@ -107,6 +122,7 @@ struct refinement_frame {
   std::span<const std::uint32_t> leaf_pixels;      // per triangle: pixels it covers (projected area)
   std::span<const std::uint32_t> visible;          // the leaves with leaf_pixels > 0, in any order
   std::span<const float> vertex_luminance;         // per vertex (valid for vertices of visible leaves)
+  std::span<const glm::vec3> vertex_colour;        // per vertex, as vertex_luminance (NLD_IS's display_quantum; empty: not applied)
   float l_max = 0.0f;                              // L_max: largest luminance of the current image
   std::size_t view_samples = 0;                    // shading samples requested since the view was set
   const pinhole_frame* projection = nullptr;       // the view's camera when it is a pinhole one (NLD_IS's areas)
@@ -136,6 +152,19 @@ inline double projected_pixels(const refinement_frame& f, std::uint32_t t) {
 inline bool qualifies(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
   return std::isfinite(o.min_pixels) && projected_pixels(f, t) >= double(o.min_pixels) && f.mesh->splittable(t);
 }
+// Leaf t covers more than always_refine_fraction of the image (§4.1's large triangles). O(1).
+inline bool large(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
+  return double(f.leaf_pixels[t]) > double(o.always_refine_fraction) * double(f.width) * double(f.height);
+}
+// NLD_IS's display rule: leaf t's corner colours differ by less than display_quantum in every
+// channel, and it is not large (see the prologue). O(1).
+inline bool shows_one_value(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
+  if (f.vertex_colour.empty() || large(f, o, t)) return false;
+  const glm::uvec3 v = f.mesh->triangle(t).vertices;
+  const glm::vec3 a = f.vertex_colour[v.x], b = f.vertex_colour[v.y], c = f.vertex_colour[v.z];
+  const glm::vec3 spread = glm::max(a, glm::max(b, c)) - glm::min(a, glm::min(b, c));
+  return std::max(spread.x, std::max(spread.y, spread.z)) < o.display_quantum;
+}
 }  // namespace detail
 
 // NLD_OS (§4, §4.1): visible leaves with S > S_req and a size of at least min_pixels, plus leaves
@@ -149,10 +178,9 @@ inline void select_nld_os(const refinement_frame& f, const criteria_options& o, 
     std::uint32_t id;
   };
   std::vector<candidate> c;
-  const double image = double(f.width) * double(f.height);
   for (std::uint32_t t : f.visible) {
     const auto px = f.leaf_pixels[t];
-    if (double(px) > o.always_refine_fraction * image) {
+    if (detail::large(f, o, t)) {
       c.push_back({true, float(px), t});
     } else if (detail::qualifies(f, o, t)) {
       const float s = detail::leaf_nld(f, t);
@@ -204,7 +232,7 @@ inline void select_nld_is(const refinement_frame& f, const criteria_options& o, 
     heap.pop();
     const std::uint32_t leaf = f.pixel_leaf[std::size_t((q.y0 + q.y1) / 2) * f.width + (q.x0 + q.x1) / 2];
     if (q.s > o.s_req && leaf != invalid_id && std::find(chosen.begin(), chosen.end(), leaf) == chosen.end() &&
-        detail::qualifies(f, o, leaf)) {
+        detail::qualifies(f, o, leaf) && !detail::shows_one_value(f, o, leaf)) {
       chosen.push_back(leaf);
       out.push_back(leaf);
     }

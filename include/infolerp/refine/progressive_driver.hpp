@@ -297,6 +297,7 @@ class progressive_refiner {
     f.leaf_pixels = view_.leaf_pixels();
     f.visible = view_.visible().unordered();
     f.vertex_luminance = cache_.luminances();
+    f.vertex_colour = cache_.colours();
     f.l_max = lum_.l_max();
     f.view_samples = cache_.view_requests();
     f.projection = has_projection_ ? &projection_ : nullptr;
