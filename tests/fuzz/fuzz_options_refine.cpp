@@ -49,6 +49,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   cam.height = r.u8() % 17u;  // is progressive_driver.hpp's own)
   const fixed_tracer wild{{r.u8() % 2u, r.index(), {r.real_f(), r.real_f()}, r.real_f()}};
   const infolerp::indexed_mesh m = fuzz::read_mesh(r, 16, 24);
+  // Read after the mesh, so that inputs written before the option still read every other field
+  // as they did; an input that ends here keeps the default.
+  if (!r.empty()) d.criteria.display_quantum = r.real_f();
 
   auto s = infolerp::subdivision_mesh::create(m, so);
   fuzz::check_error(s.error());
