@@ -1,13 +1,14 @@
 // infolerp_pareto walk --csv FILE [--width W --height H --frames N --loop P --shader simple|reference]
-//                      [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]
+//                      [--long-path [--blocks B] [--cache-bound C|none] [--hierarchy-bound T|none]]
 //
 // The walkthrough of Oliveira, Santos, Proença (§2, §4.1) on the procedural walkthrough scene:
 // a path of N frames from the street view into the temple view and back the same way
 // (support::walkthrough_path); with --loop P the path is P frames long and walked again and
 // again for N frames. With --long-path the scene is a street of B repeated blocks
 // (support::make_long_street_scene, default 26) walked from the first block to the last in N
-// frames, never coming back, with nld_os_cached alone (its cache bounded to C samples and its
-// hierarchy to T triangles if given: progressive_refiner prunes what is out of view)
+// frames, never coming back, with nld_os_cached alone, its cache bounded to C samples (default
+// 40,000) and its hierarchy to T triangles (default 150,000; `none` for no bound): the refiner
+// prunes what is out of view; the library's own default is no bound
 // and the PSNR taken every 10th frame. Three methods, every one in this run:
 //   nld_os_cached   one agent; set_view() per frame, hierarchy and shading cache kept;
 //   nld_os_restart  start() per frame (hierarchy and cache thrown away);
@@ -41,6 +42,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 #include <glm/geometric.hpp>
@@ -269,7 +271,11 @@ int pareto_walk(int argc, char** argv) {
   std::string csv_path = "walk.csv", shader_name = "simple";
   std::uint32_t width = 320, height = 240, frames = 120, loop = 0, blocks = 26;
   bool long_path = false;
-  std::size_t cache_bound = std::numeric_limits<std::size_t>::max(), hierarchy_bound = cache_bound;
+  constexpr std::size_t unbounded = std::numeric_limits<std::size_t>::max();
+  std::optional<std::size_t> cache_given, hierarchy_given;
+  const auto read_bound = [](const std::string& v) {
+    return v == "none" ? unbounded : static_cast<std::size_t>(std::max(0LL, std::atoll(v.c_str())));
+  };
   for (int i = 1; i < argc; ++i) {
     const auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
@@ -280,20 +286,22 @@ int pareto_walk(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--shader")) shader_name = next();
     else if (!std::strcmp(argv[i], "--long-path")) long_path = true;
     else if (!std::strcmp(argv[i], "--blocks")) blocks = static_cast<std::uint32_t>(std::atoi(next().c_str()));
-    else if (!std::strcmp(argv[i], "--cache-bound")) cache_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
-    else if (!std::strcmp(argv[i], "--hierarchy-bound")) hierarchy_bound = static_cast<std::size_t>(std::atoll(next().c_str()));
+    else if (!std::strcmp(argv[i], "--cache-bound")) cache_given = read_bound(next());
+    else if (!std::strcmp(argv[i], "--hierarchy-bound")) hierarchy_given = read_bound(next());
     else {
       std::fprintf(stderr, "usage: infolerp_pareto walk --csv FILE [--width W] [--height H] [--frames N] [--loop P] "
-                           "[--shader simple|reference] [--long-path [--blocks B] [--cache-bound C] [--hierarchy-bound T]]\n");
+                           "[--shader simple|reference] [--long-path [--blocks B] [--cache-bound C|none] [--hierarchy-bound T|none]]\n");
       return 2;
     }
   }
   if (frames < 2 || width == 0 || height == 0 || loop == 1 || (shader_name != "simple" && shader_name != "reference") ||
-      blocks == 0 || cache_bound == 0 || hierarchy_bound == 0 || (long_path && loop != 0)) {
+      blocks == 0 || cache_given == 0u || hierarchy_given == 0u || (long_path && loop != 0)) {
     std::fprintf(stderr, "walk: need frames >= 2, a non-empty image, --loop 0 or >= 2 (not with --long-path), "
-                         "--shader simple|reference, --blocks >= 1, --cache-bound >= 1\n");
+                         "--shader simple|reference, --blocks >= 1, bounds >= 1 or none\n");
     return 2;
   }
+  const std::size_t cache_bound = cache_given.value_or(long_path ? 40'000 : unbounded);
+  const std::size_t hierarchy_bound = hierarchy_given.value_or(long_path ? 150'000 : unbounded);
   const std::uint32_t period = loop == 0 ? frames : loop;
   const std::string stem = csv_path.substr(0, csv_path.rfind('.'));
   auto built = long_path ? infolerp::support::make_long_street_scene(blocks) : infolerp::support::make_walkthrough_scene();
