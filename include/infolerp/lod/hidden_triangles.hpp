@@ -120,14 +120,19 @@ inline view_frustum make_view_frustum(const lod_camera& cam) {
   return v;
 }
 
+// Whether triangle (a, b, c) faces away from the eye: its normal along eye → a. Single
+// precision (the positions' own): edges from the corners, not from the eye, so that a distant
+// eye costs no precision in the normal. O(1).
+inline bool facing_away(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  return glm::dot(glm::cross(b - a, c - a), a - v.eye_f) > 0.0f;
+}
+
 // Whether no pixel of the camera sees triangle (a, b, c): wholly outside one plane of the
 // frustum, or facing away from the eye when `one_sided` (on a closed part). O(1).
 inline bool hidden_triangle(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                             bool one_sided) {
-  // Single precision (the positions' own): edges from the corners, not from the eye, so that a
-  // distant eye costs no precision in the normal.
   const glm::vec3 pa = a - v.eye_f, pb = b - v.eye_f, pc = c - v.eye_f;
-  if (one_sided && glm::dot(glm::cross(b - a, c - a), pa) > 0.0f) return true;  // normal along eye → a: facing away
+  if (one_sided && facing_away(v, a, b, c)) return true;
   for (const glm::vec3& n : v.inward_f)
     if (glm::dot(n, pa) < 0.0f && glm::dot(n, pb) < 0.0f && glm::dot(n, pc) < 0.0f) return true;
   return false;
@@ -144,10 +149,8 @@ struct triangle_block {
 };
 
 // hidden[i] = hidden_triangle(v, corners of i, one_sided[i] != 0), the same single-precision
-// operations bit for bit, for i < n <= hidden_block_size; frustum false skips the frustum planes
-// (the caller knows no triangle lies outside one: box_inside_frustum). O(n), branch-free.
-inline void hidden_block(const view_frustum& v, const triangle_block& b, std::size_t n, bool frustum,
-                         std::int32_t* hidden) {
+// operations bit for bit, for i < n <= hidden_block_size. O(n), branch-free.
+inline void hidden_block(const view_frustum& v, const triangle_block& b, std::size_t n, std::int32_t* hidden) {
   const float ex = v.eye_f.x, ey = v.eye_f.y, ez = v.eye_f.z;
   for (std::size_t i = 0; i < n; ++i) {  // glm's order: cross(b − a, c − a), dot as (x + y) + z
     const float ax = b.x[0][i] - ex, ay = b.y[0][i] - ey, az = b.z[0][i] - ez;
@@ -156,7 +159,6 @@ inline void hidden_block(const view_frustum& v, const triangle_block& b, std::si
     const float nx = e1y * e2z - e2y * e1z, ny = e1z * e2x - e2z * e1x, nz = e1x * e2y - e2x * e1y;
     hidden[i] = (b.one_sided[i] != 0) & (nx * ax + ny * ay + nz * az > 0.0f);
   }
-  if (!frustum) return;
   for (std::size_t i = 0; i < n; ++i) {
     const float ax = b.x[0][i] - ex, ay = b.y[0][i] - ey, az = b.z[0][i] - ez;
     const float bx = b.x[1][i] - ex, by = b.y[1][i] - ey, bz = b.z[1][i] - ez;
@@ -171,7 +173,7 @@ inline void hidden_block(const view_frustum& v, const triangle_block& b, std::si
 
 // Whether every point of the box [lo, hi] lies inside every plane of v as hidden_triangle
 // computes it in single precision (a margin of 1e-5 of the terms covers its rounding), so that
-// no triangle within the box lies outside one. O(1).
+// no triangle within the box lies outside one: then facing_away alone decides. O(1).
 inline bool box_inside_frustum(const view_frustum& v, const glm::dvec3& lo, const glm::dvec3& hi) {
   if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return true;  // empty
   const glm::dvec3 e(v.eye_f), far = glm::max(glm::abs(lo - e), glm::abs(hi - e));

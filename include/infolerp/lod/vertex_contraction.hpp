@@ -224,14 +224,15 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
       std::uint32_t* o = dst + w.chunk_at[k];
       std::uint32_t* const o0 = o;
       const std::size_t end = std::min(w.chunk_begin[k + 1], w.run_kept[w.chunk_run[k]]);
-      if (!view) {
+      if (!frustum) {  // no culling, or every triangle inside the frustum: only the facing test, branch-free
         for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
           const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
           o[0] = a, o[1] = bb, o[2] = c;
-          o += a != bb && bb != c && a != c ? 3 : 0;
+          const bool back = back_faces_hidden && one_sided[t] != 0 && facing_away(*view, pos[a], pos[bb], pos[c]);
+          o += (a != bb) & (bb != c) & (a != c) & !back ? 3 : 0;
         }
       }
-      for (std::size_t t0 = w.chunk_begin[k]; view && t0 < end; t0 += hidden_block_size) {
+      for (std::size_t t0 = w.chunk_begin[k]; frustum && t0 < end; t0 += hidden_block_size) {
         const std::size_t n = std::min(hidden_block_size, end - t0);
         for (std::size_t i = 0; i < n; ++i) {
           const std::size_t t = t0 + i;
@@ -241,7 +242,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
           }
           corners.one_sided[i] = back_faces_hidden & (one_sided[t] != 0);
         }
-        hidden_block(*view, corners, n, frustum, hidden);
+        hidden_block(*view, corners, n, hidden);
         for (std::size_t i = 0; i < n; ++i) {
           const std::uint32_t a = ids[3 * i], bb = ids[3 * i + 1], c = ids[3 * i + 2];
           o[0] = a, o[1] = bb, o[2] = c;
