@@ -307,6 +307,7 @@ TEST_CASE("culling: frame() draws exactly the cut's triangles that hidden_triang
       auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, cut_ranges);
       REQUIRE(cut.ok());
       const view_frustum v = make_view_frustum(cams[k]);
+      CHECK(box_inside_frustum(v, w.lo, w.hi) == (k == 0));  // both of contract_visible_indices' paths
       // The cut triangle by triangle in index-buffer order (contract_indices' order; a triangle
       // it skips is degenerate), and back faces count as seen when a ray from the eye crosses
       // the cut's closed part unevenly (the eye inside it: camera 3, the torus's tube).
