@@ -229,7 +229,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
           const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
           o[0] = a, o[1] = bb, o[2] = c;
           const bool back = back_faces_hidden && one_sided[t] != 0 && facing_away(*view, pos[a], pos[bb], pos[c]);
-          o += (a != bb) & (bb != c) & (a != c) & !back ? 3 : 0;
+          o += ((a != bb) & (bb != c) & (a != c) & !back) ? 3 : 0;
         }
       }
       for (std::size_t t0 = w.chunk_begin[k]; frustum && t0 < end; t0 += hidden_block_size) {
