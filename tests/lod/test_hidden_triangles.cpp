@@ -214,3 +214,123 @@ TEST_CASE("culling: keep_hidden and two-sided clusters draw the whole cut", "[lo
     CHECK(st->indices == (opt.keep_hidden ? *cut : in_view));
   }
 }
+
+TEST_CASE("culling: blocks of triangles get hidden_triangle's answer bit for bit", "[lod]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> coord(-2.0f, 2.0f), tiny(-1e-6f, 1e-6f);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::size_t hidden_seen = 0, back_seen = 0, outside_seen = 0, tested = 0;
+  for (int round = 0; round < 200; ++round) {
+    glm::dvec3 eye(3.0 * unit(rng), 3.0 * unit(rng), 3.0 * unit(rng)), fwd(unit(rng), unit(rng), unit(rng));
+    if (round % 10 == 0) eye *= 1e4;  // far away: hidden_triangle's precision concern
+    if (glm::length(fwd) < 0.1) continue;
+    const lod_camera cam{eye, fwd, std::abs(fwd.z) > 0.9 * glm::length(fwd) ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 0, 1),
+                         0.3 + 2.0 * std::abs(unit(rng)), 64, 48};
+    REQUIRE(check_camera(cam).ok());
+    const view_frustum v = make_view_frustum(cam);
+    triangle_block b;
+    const std::size_t n = 1 + static_cast<std::size_t>(rng() % hidden_block_size);
+    std::vector<std::array<glm::vec3, 3>> tri(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (auto& p : tri[i]) p = {coord(rng), coord(rng), coord(rng)};
+      if (i % 7 == 3) tri[i][2] = tri[i][0] + (tri[i][1] - tri[i][0]) * 0.5f + glm::vec3(tiny(rng), tiny(rng), tiny(rng));  // near edge-on
+      if (i % 11 == 5) tri[i][1] = tri[i][0];                                                                     // degenerate
+      for (std::size_t j = 0; j < 3; ++j) b.x[j][i] = tri[i][j].x, b.y[j][i] = tri[i][j].y, b.z[j][i] = tri[i][j].z;
+      b.one_sided[i] = static_cast<std::int32_t>(rng() % 3 != 0);
+    }
+    std::int32_t with[hidden_block_size];
+    hidden_block(v, b, n, with);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& [p0, p1, p2] = tri[i];
+      const bool expected = hidden_triangle(v, p0, p1, p2, b.one_sided[i] != 0);
+      const bool back = hidden_triangle(v, p0, p1, p2, b.one_sided[i] != 0) && !hidden_triangle(v, p0, p1, p2, false);
+      const bool outside = hidden_triangle(v, p0, p1, p2, false);
+      CHECK(with[i] == (expected ? 1 : 0));
+      // The frustum planes or the facing test (contract_visible_indices uses the latter alone
+      // when box_inside_frustum).
+      CHECK(expected == (outside || (b.one_sided[i] != 0 && facing_away(v, p0, p1, p2))));
+      hidden_seen += expected, back_seen += back, outside_seen += outside, ++tested;
+    }
+  }
+  CHECK(hidden_seen > tested / 4);  // both answers, both reasons
+  CHECK(hidden_seen < tested);
+  CHECK(back_seen > 0);
+  CHECK(outside_seen > 0);
+}
+
+TEST_CASE("culling: a box inside the frustum holds no point outside a plane as hidden_triangle computes it", "[lod]") {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), in01(0.0, 1.0);
+  int inside = 0, not_inside = 0;
+  for (int round = 0; round < 400; ++round) {
+    const glm::dvec3 eye(5.0 * unit(rng), 5.0 * unit(rng), 5.0 * unit(rng));
+    const glm::dvec3 centre = eye + glm::dvec3(unit(rng), unit(rng), -4.0);  // mostly ahead of a camera looking along −z
+    const glm::dvec3 half(in01(rng), in01(rng), in01(rng));
+    const lod_camera cam{eye, {0.05 * unit(rng), 0.05 * unit(rng), -1.0}, {0.0, 1.0, 0.0}, 0.4 + 1.2 * in01(rng), 64, 64};
+    const view_frustum v = make_view_frustum(cam);
+    const glm::dvec3 lo = centre - half, hi = centre + half;
+    if (!box_inside_frustum(v, lo, hi)) {
+      ++not_inside;
+      continue;
+    }
+    ++inside;
+    for (int s = 0; s < 200; ++s) {  // corners and random points of the box, in single precision
+      glm::dvec3 t(in01(rng), in01(rng), in01(rng));
+      if (s < 8) t = glm::dvec3(s & 1, (s >> 1) & 1, (s >> 2) & 1);
+      const glm::vec3 p(lo + t * (hi - lo));
+      const glm::vec3 pa = glm::clamp(p, glm::vec3(lo), glm::vec3(hi)) - v.eye_f;
+      for (const glm::vec3& n : v.inward_f) CHECK(glm::dot(n, pa) >= 0.0f);
+    }
+  }
+  CHECK(inside > 20);
+  CHECK(not_inside > 20);
+  CHECK(box_inside_frustum(make_view_frustum(look_at({0, 0, 0}, {0, -1, 0})), {1, 1, 1}, {-1, -1, -1}));  // empty
+}
+
+TEST_CASE("culling: frame() draws exactly the cut's triangles that hidden_triangle finds seen, in order", "[lod]") {
+  const indexed_mesh m = support::make_torus(48, 24, 1.0f, 0.35f);
+  const lod_of s(m, 6);
+  auto lod = view_dependent_lod::create(s.h, s.table);
+  REQUIRE(lod.ok());
+  const std::vector<std::uint8_t> one_sided = closed_part_triangles(s.h.indices, s.h.positions);
+  std::vector<std::uint32_t> out(contracted_index_bound(s.h)), cut_out(out.size());
+  std::vector<index_range> ranges(s.h.cluster_count), cut_ranges(s.h.cluster_count);
+  contraction_workspace w = make_contraction_workspace(s.h, 100);
+  // Far (the whole torus in view: no frustum plane tested), close (planes cut it), inside the tube.
+  const std::vector<lod_camera> cams{look_at({0.5, -6.0, 3.0}, {0, 0, 0}), look_at({0.2, -1.6, 0.5}, {0.4, 0.0, 0.0}),
+                                     look_at({1.5, 0.0, 0.3}, {1.5, 0.0, -1.0}, {0, 1, 0}), look_at({1.0, 0.0, 0.05}, {0.0, 1.0, 0.0})};
+  for (std::size_t k = 0; k < cams.size(); ++k)
+    for (const double f : {0.0, 0.5, 0.9}) {
+      INFO("camera " << k << ", budget " << f);
+      auto st = lod->frame(cams[k], static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity())), out, ranges);
+      REQUIRE(st.ok());
+      auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, cut_ranges);
+      REQUIRE(cut.ok());
+      const view_frustum v = make_view_frustum(cams[k]);
+      CHECK(box_inside_frustum(v, w.lo, w.hi) == (k == 0));  // both of contract_visible_indices' paths
+      // The cut triangle by triangle in index-buffer order (contract_indices' order; a triangle
+      // it skips is degenerate), and back faces count as seen when a ray from the eye crosses
+      // the cut's closed part unevenly (the eye inside it: camera 3, the torus's tube).
+      contraction_workspace w2 = make_contraction_workspace(s.h, 100);
+      resolve_vertex_map(s.h, lod->stop_points(), w2);
+      auto corner = [&](std::size_t t, std::size_t j) { return w2.remap[s.h.indices[3 * t + j]]; };
+      long winding = 0;
+      for (std::size_t t = 0; t < s.h.triangle_count(); ++t)
+        if (one_sided[t] && corner(t, 0) != corner(t, 1) && corner(t, 1) != corner(t, 2) && corner(t, 0) != corner(t, 2))
+          winding += eye_ray_crossing(v, s.h.positions[corner(t, 0)], s.h.positions[corner(t, 1)], s.h.positions[corner(t, 2)]);
+      if (k == 3 && f == 0.0) CHECK(winding != 0);
+      std::vector<std::uint32_t> expected;
+      std::size_t kept_seen = 0;
+      for (std::size_t t = 0; t < s.h.triangle_count(); ++t) {
+        const std::uint32_t a = corner(t, 0), b = corner(t, 1), c = corner(t, 2);
+        if (a == b || b == c || a == c) continue;
+        ++kept_seen;
+        if (!hidden_triangle(v, s.h.positions[a], s.h.positions[b], s.h.positions[c], winding == 0 && one_sided[t] != 0))
+          expected.insert(expected.end(), {a, b, c});
+      }
+      CHECK(kept_seen * 3 == *cut);
+      CHECK(expected.size() < *cut);
+      CHECK(st->indices == expected.size());
+      CHECK(std::equal(expected.begin(), expected.end(), out.begin()));
+    }
+}

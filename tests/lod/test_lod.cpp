@@ -2,14 +2,17 @@
 // (salient-clustering paper §III.C, §IV).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
 #include <random>
+#include <span>
 #include <vector>
 #include <catch2/catch.hpp>
 #include "infolerp/lod/contraction_hierarchy.hpp"
+#include "infolerp/lod/screen_error_selection.hpp"
 #include "infolerp/lod/vertex_contraction.hpp"
 #include "infolerp/lod/view_dependent_lod.hpp"
 #include "infolerp/lod/view_selection.hpp"
@@ -499,4 +502,117 @@ TEST_CASE("real meshes: hierarchy to the backstop stays manifold", "[lod][real]"
     for (const auto& [e, n] : und) non_manifold += n > 2 ? 1 : 0;
     CHECK(non_manifold == 0);
   }
+}
+
+namespace {
+
+// budgets_for_removal as first written: 64 steps over the bits of τ, each summing budget_at
+// over every cluster's whole range (the reference for the narrowed search).
+double reference_budgets(const contraction_hierarchy& h, std::span<const float> maxima, std::span<const std::uint32_t> faces,
+                         std::span<const double> k, std::span<const double> share, double goal, std::span<std::uint64_t> budget) {
+  auto seen = [&](std::uint32_t c, std::uint64_t b) { return share[c] * static_cast<double>(removed_at(h, faces, c, b)); };
+  auto sum_at = [&](double tau) {
+    double s = 0.0;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, budget_at(h, maxima, c, k[c], tau));
+    return s;
+  };
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const std::uint64_t top = std::bit_cast<std::uint64_t>(inf);
+  std::uint64_t lo = 0, hi = top;
+  bool below_zero = false;
+  if (sum_at(inf) <= goal) lo = top;
+  else if (sum_at(0.0) > goal) below_zero = true, hi = 0;
+  while (!below_zero && lo != top && hi - lo > 1) {
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    (sum_at(std::bit_cast<double>(mid)) <= goal ? lo : hi) = mid;
+  }
+  double sum = 0.0;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+    sum += seen(c, budget[c] = below_zero ? 0 : budget_at(h, maxima, c, k[c], std::bit_cast<double>(lo)));
+  if (lo == top) return sum;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    const std::uint64_t more = budget_at(h, maxima, c, k[c], std::bit_cast<double>(hi));
+    if (more <= budget[c]) continue;
+    if (share[c] <= 0.0) {
+      budget[c] = more;
+      continue;
+    }
+    const double room = static_cast<double>(removed_at(h, faces, c, budget[c])) + (goal - sum) / share[c];
+    const auto b = faces.begin() + h.cluster_offsets[c];
+    const auto at = std::upper_bound(b + static_cast<long>(budget[c]), b + static_cast<long>(more), room,
+                                     [](double r, std::uint32_t f) { return r < static_cast<double>(f); });
+    const auto nb = static_cast<std::uint64_t>(at - b);
+    sum += seen(c, nb) - seen(c, budget[c]);
+    budget[c] = nb;
+  }
+  return sum;
+}
+
+}  // namespace
+
+TEST_CASE("selection: matching through the neighbour table and the narrowed bisection give the plain results", "[lod]") {
+  const indexed_mesh m = support::subdivide_midpoint(support::make_icosphere(3));
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  std::vector<double> wt(3 * m.triangle_count());
+  for (std::size_t i = 0; i < wt.size(); ++i) wt[i] = 1.0 + 0.8 * std::sin(0.37 * static_cast<double>(i));
+  auto h = make_contraction_hierarchy(m, wt, cl, 8, {.backstop = 0.01});
+  REQUIRE(h.ok());
+  REQUIRE(h->cross.size() > 50);
+  const neighbour_table table = make_neighbour_table(*h);
+  const std::vector<float> maxima = cluster_error_maxima(*h);
+  const std::vector<std::uint32_t> faces = cluster_removed_faces(*h);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> in01(0.0, 1.0);
+  std::size_t raised = 0;
+  for (int round = 0; round < 300; ++round) {
+    std::vector<std::uint32_t> stop(8), plain;
+    for (auto& s : stop) s = static_cast<std::uint32_t>(rng() % (h->contraction_count() + 1));
+    plain = stop;
+    const std::uint32_t a = match_neighbours(*h, plain), b = match_neighbours(*h, table, stop);
+    CHECK(a == b);
+    CHECK(plain == stop);
+    raised += a > 1;
+    std::vector<double> k(8), share(8);
+    for (std::uint32_t c = 0; c < 8; ++c) k[c] = std::exp(6.0 * in01(rng) - 3.0), share[c] = round % 5 == 0 ? 1.0 : in01(rng);
+    if (round % 7 == 0) share[rng() % 8] = 0.0;
+    const double goal = (1.2 * in01(rng) - 0.1) * static_cast<double>(h->triangle_count());
+    std::vector<std::uint64_t> budget(8), ref(8);
+    const double sb = budgets_for_removal(*h, maxima, faces, k, share, goal, budget);
+    const double sr = reference_budgets(*h, maxima, faces, k, share, goal, ref);
+    CHECK(sb == sr);
+    CHECK(budget == ref);
+  }
+  CHECK(raised > 10);
+}
+
+TEST_CASE("vertex contraction: the map updated between frames equals the map resolved anew", "[lod]") {
+  const indexed_mesh m = support::subdivide_midpoint(support::make_icosphere(3));
+  const std::vector<std::uint32_t> cl = octant_clusters(m);
+  auto h = uniform_hierarchy(m, cl, 8, 0.01);
+  REQUIRE(h.ok());
+  const auto n = static_cast<std::uint32_t>(h->contraction_count());
+  contraction_workspace kept_between = make_contraction_workspace(*h);
+  REQUIRE(kept_between.toggled.size() > 10);
+  std::mt19937 rng(17);
+  std::vector<std::uint32_t> stop(8, n / 2);
+  std::size_t small_steps = 0;
+  for (int frame = 0; frame < 400; ++frame) {
+    // Mostly small moves of a few stop points (a moving camera), sometimes a jump of all of them.
+    if (frame % 25 == 0) {
+      for (auto& s : stop) s = static_cast<std::uint32_t>(rng() % (n + 1));
+    } else {
+      for (int moves = 0; moves < 3; ++moves) {
+        std::uint32_t& s = stop[rng() % 8];
+        const auto step = static_cast<std::int64_t>(rng() % 41) - 20;
+        s = static_cast<std::uint32_t>(std::clamp<std::int64_t>(s + step, 0, n));
+      }
+      ++small_steps;
+    }
+    if (frame % 3 == 0) match_neighbours(*h, stop);
+    resolve_vertex_map(*h, stop, kept_between);
+    contraction_workspace fresh = make_contraction_workspace(*h);
+    resolve_vertex_map(*h, stop, fresh);
+    REQUIRE(kept_between.remap == fresh.remap);
+  }
+  CHECK(small_steps > 300);
 }

@@ -120,17 +120,68 @@ inline view_frustum make_view_frustum(const lod_camera& cam) {
   return v;
 }
 
+// Whether triangle (a, b, c) faces away from the eye: its normal along eye → a. Single
+// precision (the positions' own): edges from the corners, not from the eye, so that a distant
+// eye costs no precision in the normal. O(1).
+inline bool facing_away(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  return glm::dot(glm::cross(b - a, c - a), a - v.eye_f) > 0.0f;
+}
+
 // Whether no pixel of the camera sees triangle (a, b, c): wholly outside one plane of the
 // frustum, or facing away from the eye when `one_sided` (on a closed part). O(1).
 inline bool hidden_triangle(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                             bool one_sided) {
-  // Single precision (the positions' own): edges from the corners, not from the eye, so that a
-  // distant eye costs no precision in the normal.
   const glm::vec3 pa = a - v.eye_f, pb = b - v.eye_f, pc = c - v.eye_f;
-  if (one_sided && glm::dot(glm::cross(b - a, c - a), pa) > 0.0f) return true;  // normal along eye → a: facing away
+  if (one_sided && facing_away(v, a, b, c)) return true;
   for (const glm::vec3& n : v.inward_f)
     if (glm::dot(n, pa) < 0.0f && glm::dot(n, pb) < 0.0f && glm::dot(n, pc) < 0.0f) return true;
   return false;
+}
+
+// Triangles hidden_block tests at once.
+inline constexpr std::size_t hidden_block_size = 64;
+
+// The corners of up to hidden_block_size triangles, one array per coordinate and corner (a
+// structure of arrays, so that hidden_block's loop runs on several triangles per instruction).
+struct triangle_block {
+  float x[3][hidden_block_size], y[3][hidden_block_size], z[3][hidden_block_size];
+  std::int32_t one_sided[hidden_block_size];  // nonzero: back faces hidden
+};
+
+// hidden[i] = hidden_triangle(v, corners of i, one_sided[i] != 0), the same single-precision
+// operations bit for bit, for i < n <= hidden_block_size. O(n), branch-free.
+inline void hidden_block(const view_frustum& v, const triangle_block& b, std::size_t n, std::int32_t* hidden) {
+  const float ex = v.eye_f.x, ey = v.eye_f.y, ez = v.eye_f.z;
+  for (std::size_t i = 0; i < n; ++i) {  // glm's order: cross(b − a, c − a), dot as (x + y) + z
+    const float ax = b.x[0][i] - ex, ay = b.y[0][i] - ey, az = b.z[0][i] - ez;
+    const float e1x = b.x[1][i] - b.x[0][i], e1y = b.y[1][i] - b.y[0][i], e1z = b.z[1][i] - b.z[0][i];
+    const float e2x = b.x[2][i] - b.x[0][i], e2y = b.y[2][i] - b.y[0][i], e2z = b.z[2][i] - b.z[0][i];
+    const float nx = e1y * e2z - e2y * e1z, ny = e1z * e2x - e2z * e1x, nz = e1x * e2y - e2x * e1y;
+    hidden[i] = (b.one_sided[i] != 0) & (nx * ax + ny * ay + nz * az > 0.0f);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const float ax = b.x[0][i] - ex, ay = b.y[0][i] - ey, az = b.z[0][i] - ez;
+    const float bx = b.x[1][i] - ex, by = b.y[1][i] - ey, bz = b.z[1][i] - ez;
+    const float cx = b.x[2][i] - ex, cy = b.y[2][i] - ey, cz = b.z[2][i] - ez;
+    std::int32_t out = 0;
+    for (const glm::vec3& p : v.inward_f)
+      out |= (p.x * ax + p.y * ay + p.z * az < 0.0f) & (p.x * bx + p.y * by + p.z * bz < 0.0f) &
+             (p.x * cx + p.y * cy + p.z * cz < 0.0f);
+    hidden[i] |= out;
+  }
+}
+
+// Whether every point of the box [lo, hi] lies inside every plane of v as hidden_triangle
+// computes it in single precision (a margin of 1e-5 of the terms covers its rounding), so that
+// no triangle within the box lies outside one: then facing_away alone decides. O(1).
+inline bool box_inside_frustum(const view_frustum& v, const glm::dvec3& lo, const glm::dvec3& hi) {
+  if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return true;  // empty
+  const glm::dvec3 e(v.eye_f), far = glm::max(glm::abs(lo - e), glm::abs(hi - e));
+  for (const glm::vec3& pf : v.inward_f) {
+    const glm::dvec3 p(pf), corner(p.x >= 0.0 ? lo.x : hi.x, p.y >= 0.0 ? lo.y : hi.y, p.z >= 0.0 ? lo.z : hi.z);
+    if (!(glm::dot(p, corner - e) >= 1e-5 * glm::dot(glm::abs(p), far))) return false;
+  }
+  return true;
 }
 
 // The signed crossing of a fixed ray from the eye (a direction of irrational slopes, so that

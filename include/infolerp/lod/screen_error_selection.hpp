@@ -190,6 +190,16 @@ inline double budgets_for_removal(const contraction_hierarchy& h, std::span<cons
                                   std::span<const std::uint32_t> faces, std::span<const double> k,
                                   std::span<const double> share, double goal, std::span<std::uint64_t> budget) {
   auto seen = [&](std::uint32_t c, std::uint64_t b) { return share[c] * static_cast<double>(removed_at(h, faces, c, b)); };
+  // During the bisection budget[c] holds c's budgets at lo (low 32 bits) and hi (high 32 bits;
+  // capacities fit, orders being 32-bit): budgets grow with τ, so budget_at at a τ between them
+  // lies between them and is searched for there.
+  auto between = [&](std::uint32_t c, double tau) {
+    const auto b = maxima.begin() + h.cluster_offsets[c];
+    const double limit = tau / k[c];  // as budget_at
+    return static_cast<std::uint64_t>(std::upper_bound(b + static_cast<long>(budget[c] & 0xffffffffu),
+                                                       b + static_cast<long>(budget[c] >> 32), limit,
+                                                       [](double l, float x) { return l < static_cast<double>(x); }) - b);
+  };
   auto sum_at = [&](double tau) {
     double s = 0.0;
     for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, budget_at(h, maxima, c, k[c], tau));
@@ -203,9 +213,17 @@ inline double budgets_for_removal(const contraction_hierarchy& h, std::span<cons
   bool below_zero = false;
   if (sum_at(inf) <= goal) lo = top;
   else if (sum_at(0.0) > goal) below_zero = true, hi = 0;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = budget_at(h, maxima, c, k[c], 0.0) | h.capacity(c) << 32;
   while (!below_zero && lo != top && hi - lo > 1) {
     const std::uint64_t mid = lo + (hi - lo) / 2;
-    (sum_at(std::bit_cast<double>(mid)) <= goal ? lo : hi) = mid;
+    double s = 0.0;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, between(c, std::bit_cast<double>(mid)));
+    const bool below = s <= goal;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c) {  // the budget at mid bounds its side
+      const std::uint64_t m = between(c, std::bit_cast<double>(mid));
+      budget[c] = below ? (budget[c] >> 32 << 32) | m : (budget[c] & 0xffffffffu) | m << 32;
+    }
+    (below ? lo : hi) = mid;
   }
   double sum = 0.0;
   for (std::uint32_t c = 0; c < h.cluster_count; ++c)
@@ -242,8 +260,10 @@ struct selection_stats {
 // the longest global prefix of at most `prefix` contractions that draws as many. k and budget are
 // scratch (one per cluster). Preconditions: check_camera(cam) passed, options in range, maxima
 // = cluster_error_maxima(h), faces = cluster_removed_faces(h), spans one per cluster, shares in
-// [0, 1], prefix <= h.contraction_count(). O(12 · (64 · C log n + matching)), no allocation.
-inline selection_stats select_for_view(const contraction_hierarchy& h, std::span<const view_patch> patches,
+// [0, 1], prefix <= h.contraction_count(), neighbours = make_neighbour_table(h).
+// O(12 · (64 · C log n + matching)), no allocation.
+inline selection_stats select_for_view(const contraction_hierarchy& h, const neighbour_table& neighbours,
+                                       std::span<const view_patch> patches,
                                        std::span<const float> maxima, std::span<const std::uint32_t> faces,
                                        const lod_camera& cam, const view_weight_options& opt,
                                        std::span<const double> share, std::uint64_t triangles, std::uint64_t prefix,
@@ -264,7 +284,7 @@ inline selection_stats select_for_view(const contraction_hierarchy& h, std::span
     st.budgeted = 0;
     for (std::uint64_t b : budget) st.budgeted += b;
     (void)stop_points_from_budgets(h, budget, stop);  // budgets never exceed capacities
-    match_neighbours(h, stop);
+    match_neighbours(h, neighbours, stop);
     double removed = 0.0;
     st.applied = 0;
     for (std::uint32_t c = 0; c < h.cluster_count; ++c) {

@@ -5,7 +5,8 @@
 // The paper iterates a shader maxContractionLevel times, each index following one contraction
 // per pass. Here the chains are resolved once per frame: walking the contractions from the last
 // to the first, remap[removed] = remap[target] if the contraction is applied, removed otherwise
-// (a target is removed only by a later contraction, so its entry is final when read).
+// (a target is removed only by a later contraction, so its entry is final when read); between
+// frames only the contractions whose state changed are redone, with the chains through them.
 // Triangles are not tested one by one for removal: inside each cluster the hierarchy orders them
 // in runs by the owner of their removing contraction (contraction_hierarchy::killer), latest
 // removal first, so the triangles a frame keeps are a prefix of each run, found by binary search. At dependency-closed stop points (neighbour matching's
@@ -19,7 +20,9 @@
 // cluster). Chunk boundaries depend only on the hierarchy and the grain, so the output has
 // identical bits for any executor.
 // contract_visible_indices also drops each triangle the camera cannot see (hidden_triangles.hpp),
-// one test per kept triangle in the same parallel pass; a first pass sums the signed crossings
+// tested in the same parallel pass by blocks of kept triangles whose corners are gathered into
+// arrays per coordinate (one instruction tests several; the frustum planes are skipped when the
+// box of all positions lies inside them); a first pass sums the signed crossings
 // of a ray from the eye with the closed parts' kept triangles, and back faces are kept when the
 // eye is inside.
 // One vertex map serves every cluster, so a vertex on a cluster border contracts the same way
@@ -28,9 +31,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <span>
 #include <type_traits>
 #include <vector>
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
 #include "infolerp/core/executor.hpp"
 #include "infolerp/core/status.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
@@ -58,6 +64,10 @@ struct contraction_workspace {
   std::vector<std::size_t> chunk_at;         // per chunk, this frame: output offset if nothing is dropped
   std::vector<std::uint32_t> chunk_count;    // per chunk, this frame: indices written
   std::vector<std::int32_t> chunk_winding;   // per chunk, this frame (culling): signed crossings of a ray from the eye
+  glm::dvec3 lo{0.0}, hi{-1.0};              // the box of h.positions (empty without them): of every cut
+  // resolve_vertex_map between frames: the stop points remap holds (empty: none yet), per vertex
+  // the contractions whose target it is (CSR), scratch for the contractions to redo and a stack.
+  std::vector<std::uint32_t> resolved_stop, child_offsets, children, toggled, stack;
   std::size_t grain = 0;
 };
 
@@ -84,22 +94,77 @@ inline contraction_workspace make_contraction_workspace(const contraction_hierar
   w.chunk_at.assign(w.chunk_run.size(), 0);
   w.chunk_count.assign(w.chunk_run.size(), 0);
   w.chunk_winding.assign(w.chunk_run.size(), 0);
+  w.child_offsets.assign(std::size_t{h.vertex_count} + 1, 0);
+  for (std::uint32_t v : h.target) ++w.child_offsets[v + 1];
+  for (std::uint32_t v = 0; v < h.vertex_count; ++v) w.child_offsets[v + 1] += w.child_offsets[v];
+  w.children.resize(h.contraction_count());
+  std::vector<std::uint32_t> at(w.child_offsets.begin(), w.child_offsets.end() - 1);
+  for (std::uint32_t i = 0; i < h.contraction_count(); ++i) w.children[at[h.target[i]]++] = i;
+  w.toggled.resize(h.contraction_count() / 8);
+  w.stack.resize(h.vertex_count);
+  w.resolved_stop.reserve(h.cluster_count);
+  if (!h.positions.empty()) w.lo = w.hi = glm::dvec3(h.positions[0]);
+  for (const glm::vec3& p : h.positions) w.lo = glm::min(w.lo, glm::dvec3(p)), w.hi = glm::max(w.hi, glm::dvec3(p));
   return w;
 }
 
-// The vertex map of a frame: contraction i is applied iff i < stop[owner(i)]. Preconditions:
-// w from this hierarchy, stop one per cluster. O(contractions), serial, no allocation.
+namespace detail {
+// The vertex map for stop from the one for w.resolved_stop: the contractions whose state
+// differs are redone from the last to the first, each giving its removed vertex and every vertex
+// whose applied chain passes through it (a walk down the children) their new end; the chains of
+// all other vertices are unchanged. False (nothing done) when no map is held or more than
+// w.toggled.size() contractions differ.
+inline bool update_vertex_map(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
+                              contraction_workspace& w) {
+  if (w.resolved_stop.size() != stop.size()) return false;
+  std::size_t n = 0;
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    const std::uint32_t a = std::min(stop[c], w.resolved_stop[c]), z = std::max(stop[c], w.resolved_stop[c]);
+    if (a == z) continue;
+    const auto end = h.cluster_contractions.begin() + h.cluster_offsets[c + 1];
+    const auto b = std::lower_bound(h.cluster_contractions.begin() + h.cluster_offsets[c], end, a);
+    const auto e = std::lower_bound(b, end, z);
+    if (static_cast<std::size_t>(e - b) > w.toggled.size() - n) return false;
+    n = static_cast<std::size_t>(std::copy(b, e, w.toggled.begin() + static_cast<long>(n)) - w.toggled.begin());
+  }
+  std::sort(w.toggled.begin(), w.toggled.begin() + static_cast<long>(n), std::greater<>());
+  std::uint32_t* remap = w.remap.data();
+  std::uint32_t* stack = w.stack.data();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t i = w.toggled[k], u = h.removed[i];
+    const std::uint32_t r = i < stop[h.owner[i]] ? remap[h.target[i]] : u;  // final: set by later contractions
+    remap[u] = r;
+    std::size_t top = 0;
+    stack[top++] = u;
+    while (top > 0) {
+      const std::uint32_t x = stack[--top];
+      for (std::uint32_t q = w.child_offsets[x]; q < w.child_offsets[x + 1]; ++q)
+        if (const std::uint32_t j = w.children[q]; j < stop[h.owner[j]]) remap[h.removed[j]] = r, stack[top++] = h.removed[j];
+    }
+  }
+  return true;
+}
+}  // namespace detail
+
+// The vertex map of a frame: contraction i is applied iff i < stop[owner(i)]. Between frames
+// only the contractions whose state changed and the chains through them are redone (at most
+// contractions / 8 of them, else all). Preconditions: w from this hierarchy, stop one per
+// cluster. O(changed contractions · log + the vertices whose chains pass through them), at most
+// O(contractions); serial, no allocation.
 inline void resolve_vertex_map(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,
                                contraction_workspace& w) {
-  const std::uint32_t* removed = h.removed.data();
-  const std::uint32_t* target = h.target.data();
-  const std::uint32_t* owner = h.owner.data();
-  std::uint32_t* remap = w.remap.data();
-  for (std::size_t i = h.contraction_count(); i-- > 0;) {
-    // A mask instead of a branch: per-cluster stop points make "applied" unpredictable.
-    const std::uint32_t u = removed[i], applied = 0u - static_cast<std::uint32_t>(i < stop[owner[i]]);
-    remap[u] = (remap[target[i]] & applied) | (u & ~applied);
+  if (!detail::update_vertex_map(h, stop, w)) {
+    const std::uint32_t* removed = h.removed.data();
+    const std::uint32_t* target = h.target.data();
+    const std::uint32_t* owner = h.owner.data();
+    std::uint32_t* remap = w.remap.data();
+    for (std::size_t i = h.contraction_count(); i-- > 0;) {
+      // A mask instead of a branch: per-cluster stop points make "applied" unpredictable.
+      const std::uint32_t u = removed[i], applied = 0u - static_cast<std::uint32_t>(i < stop[owner[i]]);
+      remap[u] = (remap[target[i]] & applied) | (u & ~applied);
+    }
   }
+  w.resolved_stop.assign(stop.begin(), stop.end());
 }
 
 namespace detail {
@@ -150,17 +215,39 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
     for (std::size_t k = 0; k < w.chunk_run.size(); ++k) winding += w.chunk_winding[k];
     back_faces_hidden = winding == 0;
   }
+  const bool frustum = view && !box_inside_frustum(*view, w.lo, w.hi);
   exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
+    triangle_block corners;  // culling: blocks of triangles, remapped and gathered, tested, then written
+    std::uint32_t ids[3 * hidden_block_size];
+    std::int32_t hidden[hidden_block_size];
     for (std::size_t k = b; k < e; ++k) {
       std::uint32_t* o = dst + w.chunk_at[k];
       std::uint32_t* const o0 = o;
       const std::size_t end = std::min(w.chunk_begin[k + 1], w.run_kept[w.chunk_run[k]]);
-      for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
-        const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
-        o[0] = a, o[1] = bb, o[2] = c;
-        const bool drawn = a != bb && bb != c && a != c &&
-                           !(view && hidden_triangle(*view, pos[a], pos[bb], pos[c], back_faces_hidden && one_sided[t] != 0));
-        o += drawn ? 3 : 0;
+      if (!frustum) {  // no culling, or every triangle inside the frustum: only the facing test, branch-free
+        for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
+          const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
+          o[0] = a, o[1] = bb, o[2] = c;
+          const bool back = back_faces_hidden && one_sided[t] != 0 && facing_away(*view, pos[a], pos[bb], pos[c]);
+          o += ((a != bb) & (bb != c) & (a != c) & !back) ? 3 : 0;
+        }
+      }
+      for (std::size_t t0 = w.chunk_begin[k]; frustum && t0 < end; t0 += hidden_block_size) {
+        const std::size_t n = std::min(hidden_block_size, end - t0);
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::size_t t = t0 + i;
+          for (std::size_t j = 0; j < 3; ++j) {
+            const glm::vec3& p = pos[ids[3 * i + j] = remap[src[3 * t + j]]];
+            corners.x[j][i] = p.x, corners.y[j][i] = p.y, corners.z[j][i] = p.z;
+          }
+          corners.one_sided[i] = back_faces_hidden & (one_sided[t] != 0);
+        }
+        hidden_block(*view, corners, n, hidden);
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::uint32_t a = ids[3 * i], bb = ids[3 * i + 1], c = ids[3 * i + 2];
+          o[0] = a, o[1] = bb, o[2] = c;
+          o += a != bb && bb != c && a != c && !hidden[i] ? 3 : 0;
+        }
       }
       w.chunk_count[k] = static_cast<std::uint32_t>(o - o0);
     }
@@ -184,7 +271,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
 // Algorithm 1: the frame's index buffer into out (at least contracted_index_bound(h) entries)
 // and one range per cluster. Returns the indices written. Errors: out too small or ranges not
 // one per cluster (bad_size), stop not one per cluster (bad_size). Preconditions: w from this
-// hierarchy; stop dependency-closed (see the top of the file). O(contractions + runs · log T +
+// hierarchy; stop dependency-closed (see the top of the file). O(resolve_vertex_map + runs · log T +
 // kept triangles / threads + chunks), no allocation unless an error is returned; identical bits
 // for any executor.
 template <class E = serial_executor>

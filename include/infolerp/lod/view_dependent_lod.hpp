@@ -133,14 +133,14 @@ class view_dependent_lod {
     if (opt_.selection == lod_selection::screen_error) {
       if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
       else visible_shares(samples_, view, eye_outside_coarsest(samples_, view), share_);
-      const selection_stats sel = select_for_view(*h_, patches_, maxima_, faces_, camera, opt_.view, share_,
+      const selection_stats sel = select_for_view(*h_, neighbours_, patches_, maxima_, faces_, camera, opt_.view, share_,
                                                   st.triangle_budget, global_contractions, area_, budget_, stop_);
       st.budgeted = sel.budgeted, st.applied = sel.applied, st.matching_sweeps = sel.rounds;
       st.estimated = static_cast<std::uint64_t>(std::max(0.0, std::round(sel.drawn)));
     } else {
       if (status s = paper_stop_points(camera.position, global_contractions); !s.ok()) return s;
       for (std::uint64_t b : budget_) st.budgeted += b;
-      st.matching_sweeps = match_neighbours(*h_, stop_);
+      st.matching_sweeps = match_neighbours(*h_, neighbours_, stop_);
       st.applied = applied_total(*h_, stop_);
     }
     auto n = opt_.keep_hidden ? contract_indices(*h_, stop_, work_, out, ranges, exec)
@@ -152,7 +152,8 @@ class view_dependent_lod {
 
  private:
   view_dependent_lod(const contraction_hierarchy& h, const cluster_table& table, const lod_options& opt)
-      : h_(&h), table_(&table), opt_(opt), work_(make_contraction_workspace(h, opt.grain)) {
+      : h_(&h), table_(&table), opt_(opt), work_(make_contraction_workspace(h, opt.grain)),
+        neighbours_(make_neighbour_table(h)) {
     const std::size_t c = h.cluster_count;
     area_.resize(c), importance_.resize(c), priority_.resize(c), order_.resize(c), budget_.resize(c), stop_.resize(c);
     capacity_.resize(c), share_.resize(c);
@@ -190,6 +191,7 @@ class view_dependent_lod {
   const cluster_table* table_;
   lod_options opt_;
   contraction_workspace work_;
+  neighbour_table neighbours_;
   std::vector<double> area_, importance_, priority_, share_;  // screen_error: area_ holds k_c
   std::vector<std::uint64_t> kept_;                          // triangles the global prefix of i contractions keeps
   std::vector<std::uint32_t> faces_;                         // cluster_removed_faces

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 #include "infolerp/core/status.hpp"
 #include "infolerp/lod/contraction_hierarchy.hpp"
 
@@ -68,6 +69,57 @@ inline std::uint32_t match_neighbours(const contraction_hierarchy& h, std::span<
       for (std::uint32_t k = h.cross_offsets[c]; k < h.cross_offsets[c + 1] && h.cross[k].order < stop[c]; ++k) {
         std::uint32_t& s = stop[h.cross[k].cluster];
         if (s <= h.cross[k].needs) s = h.cross[k].needs + 1, changed = true;
+      }
+  }
+  return sweeps;
+}
+
+// Per cluster c and each other cluster c' it depends on: c's cross dependencies on c' by
+// ascending order with the running maximum of `needs`, so that matching reads the raise each
+// stop point implies by one binary search instead of one step per dependency.
+struct neighbour_table {
+  std::vector<std::uint32_t> pair_offsets;  // per cluster, pairs + 1 (CSR)
+  std::vector<std::uint32_t> pair_cluster;  // per pair: c'
+  std::vector<std::uint32_t> pair_begin;    // per pair, entries + 1
+  std::vector<std::uint32_t> order, needs_max;
+};
+
+// O(cross-cluster dependencies · clusters), allocation: the result.
+inline neighbour_table make_neighbour_table(const contraction_hierarchy& h) {
+  neighbour_table t;
+  t.pair_offsets.push_back(0);
+  t.pair_begin.push_back(0);
+  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    for (std::uint32_t o = 0; o < h.cluster_count; ++o) {
+      std::uint32_t m = 0;
+      const std::size_t first = t.order.size();
+      for (std::uint32_t k = h.cross_offsets[c]; k < h.cross_offsets[c + 1]; ++k)
+        if (h.cross[k].cluster == o) t.order.push_back(h.cross[k].order), t.needs_max.push_back(m = std::max(m, h.cross[k].needs));
+      if (t.order.size() == first) continue;
+      t.pair_cluster.push_back(o);
+      t.pair_begin.push_back(static_cast<std::uint32_t>(t.order.size()));
+    }
+    t.pair_offsets.push_back(static_cast<std::uint32_t>(t.pair_cluster.size()));
+  }
+  return t;
+}
+
+// match_neighbours with t = make_neighbour_table(h): the same stop points and sweeps.
+// O(sweeps · pairs · log dependencies), no allocation.
+inline std::uint32_t match_neighbours(const contraction_hierarchy& h, const neighbour_table& t,
+                                      std::span<std::uint32_t> stop) {
+  std::uint32_t sweeps = 0;
+  for (bool changed = true; changed;) {
+    changed = false;
+    ++sweeps;
+    for (std::uint32_t c = 0; c < h.cluster_count; ++c)  // c' != c: stop[c] holds during c's pairs
+      for (std::uint32_t p = t.pair_offsets[c]; p < t.pair_offsets[c + 1]; ++p) {
+        const auto b = t.order.begin() + t.pair_begin[p], e = t.order.begin() + t.pair_begin[p + 1];
+        const auto n = std::lower_bound(b, e, stop[c]) - b;  // the applied ones
+        if (n == 0) continue;
+        const std::uint32_t need = t.needs_max[t.pair_begin[p] + static_cast<std::size_t>(n) - 1];
+        std::uint32_t& s = stop[t.pair_cluster[p]];
+        if (s <= need) s = need + 1, changed = true;
       }
   }
   return sweeps;
