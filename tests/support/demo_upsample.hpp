@@ -217,12 +217,13 @@ struct demo_material {
   template <class View>
   glm::vec3 operator()(const demo_sample& s, const View& view) const {
     shading_inputs in;
-    if (s.background() || (s.lights & sun_light_bit) != 0) in.view = view();
+    const std::uint32_t g = s.background() ? invalid_id : clusters->geometry_of[s.cluster];
+    if (s.background() || ((s.lights & sun_light_bit) != 0 && shader->scene().objects[g].mat.specular != 0.0f)) in.view = view();
     if (s.background()) return shader->shade(in);
     in.position = s.position;
     in.normal = s.normal;
     in.uv = s.texcoord;
-    in.geometry = clusters->geometry_of[s.cluster];
+    in.geometry = g;
     in.light_bits = s.lights;
     in.ao = s.occlusion[0];
     in.soft_shadow = s.occlusion[1];
