@@ -112,19 +112,24 @@ struct demo_ibuffer_source {
     }
     return s;
   }
-  // shade() reads the view direction only for the sky and the sun's highlight, so the primary
-  // ray is rebuilt only for those pixels (the same bits as always rebuilding it). The normal is
+  // shade() reads the view direction only for the sky and the sun's highlight on specular
+  // materials, so the primary ray is rebuilt only for those pixels (the same bits as always rebuilding it). The normal is
   // renormalised: interpolated normals are not unit.
+  // A vector whose length is exactly 1 is kept as is: dividing by 1 would give the same bits.
   shading_inputs to_inputs(const demo_sample& s, std::uint32_t x, std::uint32_t y) const {
     shading_inputs in;
-    if (s.background() || (s.lights & sun_light_bit) != 0)
-      in.view = glm::normalize(shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction);
+    const std::uint32_t g = s.background() ? invalid_id : clusters->geometry_of[s.cluster];
+    if (s.background() || ((s.lights & sun_light_bit) != 0 && shader->scene().objects[g].mat.specular != 0.0f)) {
+      const glm::vec3 d = shader->primary_ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, width, height).direction;
+      const float len = std::sqrt(glm::dot(d, d));
+      in.view = len == 1.0f ? d : d * (1.0f / len);  // glm::normalize's bits
+    }
     if (s.background()) return in;
     in.position = s.position;
     const float len = glm::length(s.normal);
-    in.normal = len > 0.0f ? s.normal / len : s.normal;
+    in.normal = len > 0.0f && len != 1.0f ? s.normal / len : s.normal;
     in.uv = s.texcoord;
-    in.geometry = clusters->geometry_of[s.cluster];
+    in.geometry = g;
     in.light_bits = s.lights;
     in.ao = s.occlusion[0];
     in.soft_shadow = s.occlusion[1];
@@ -212,12 +217,13 @@ struct demo_material {
   template <class View>
   glm::vec3 operator()(const demo_sample& s, const View& view) const {
     shading_inputs in;
-    if (s.background() || (s.lights & sun_light_bit) != 0) in.view = view();
+    const std::uint32_t g = s.background() ? invalid_id : clusters->geometry_of[s.cluster];
+    if (s.background() || ((s.lights & sun_light_bit) != 0 && shader->scene().objects[g].mat.specular != 0.0f)) in.view = view();
     if (s.background()) return shader->shade(in);
     in.position = s.position;
     in.normal = s.normal;
     in.uv = s.texcoord;
-    in.geometry = clusters->geometry_of[s.cluster];
+    in.geometry = g;
     in.light_bits = s.lights;
     in.ao = s.occlusion[0];
     in.soft_shadow = s.occlusion[1];

@@ -21,7 +21,8 @@ using infolerp::detail::tangent_frame;
 }  // namespace
 
 reference_shader::reference_shader(const demo_scene& scene, const shader_options& options)
-    : scene_(&scene), options_(options), rays_(scene.view.rays()) {
+    : scene_(&scene), options_(options), rays_(scene.view.rays()), area_center_(scene.area.center()),
+      area_normal_(scene.area.normal()), area_area_(scene.area.area()) {
   hemisphere_ = cosine_hemisphere(options_.ao_rays);  // cosine-weighted, Malley's method on Hammersley points
   for (unsigned i = 0; i < options_.soft_shadow_rays; ++i) {
     const glm::vec2 s = hammersley(i, options_.soft_shadow_rays);
@@ -108,7 +109,7 @@ shading_inputs reference_shader::evaluate_hit(const ray& primary, const hit& h, 
   // Soft shadow: rays to the fixed light points the surface and the light face each other at.
   if (!light_points_.empty()) {
     unsigned visible = 0;
-    const glm::vec3 light_normal = scene.area.normal();
+    const glm::vec3& light_normal = area_normal_;
     for (const glm::vec3& q : light_points_) {
       const glm::vec3 d = q - origin;  // tfar 1 reaches the light; stop just before it
       if (glm::dot(d, ng) <= 0.0f || glm::dot(d, light_normal) >= 0.0f) continue;
@@ -148,16 +149,18 @@ glm::vec3 reference_shader::shade(const shading_inputs& in) const {
   glm::vec3 highlight{0.0f};
   if (in.light_bits & sun_light_bit) {
     irradiance += scene.sun.radiance * std::max(0.0f, glm::dot(n, scene.sun.direction));
-    const glm::vec3 half = glm::normalize(scene.sun.direction - in.view);
-    highlight += mat.specular * scene.sun.radiance * std::pow(std::max(0.0f, glm::dot(n, half)), 48.0f);
+    if (mat.specular != 0.0f) {  // without it the highlight is +0 and the view is not read
+      const glm::vec3 half = glm::normalize(scene.sun.direction - in.view);
+      highlight += mat.specular * scene.sun.radiance * std::pow(std::max(0.0f, glm::dot(n, half)), 48.0f);
+    }
   }
   if (in.soft_shadow > 0.0f) {
-    const glm::vec3 d = scene.area.center() - in.position;
+    const glm::vec3 d = area_center_ - in.position;
     const float dist2 = glm::dot(d, d);
     const glm::vec3 l = d / std::sqrt(dist2);
     const float cos_surface = std::max(0.0f, glm::dot(n, l));
-    const float cos_light = std::max(0.0f, -glm::dot(l, scene.area.normal()));
-    irradiance += scene.area.radiance * (scene.area.area() * cos_surface * cos_light / (pi * dist2) * in.soft_shadow);
+    const float cos_light = std::max(0.0f, -glm::dot(l, area_normal_));
+    irradiance += scene.area.radiance * (area_area_ * cos_surface * cos_light / (pi * dist2) * in.soft_shadow);
   }
   float lod = 0.0f;  // log2 of the footprint in level-0 texels (texture.hpp)
   if (mat.texture == texture_kind::image && options_.pixel_angle > 0.0f)

@@ -87,6 +87,11 @@ class reference_shader {
   pinhole_rays rays_;
   std::vector<glm::vec3> hemisphere_;    // N cosine-weighted directions around +Z
   std::vector<glm::vec3> light_points_;  // M points on the area light
+  // The area light's centre, unit normal and area, read once like its points (shade() needs
+  // them at every pixel; recomputing them there was a cross product and a square root each).
+  glm::vec3 area_center_;
+  glm::vec3 area_normal_;
+  float area_area_;
 };
 
 struct render_stats {

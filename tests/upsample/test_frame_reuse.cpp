@@ -17,6 +17,7 @@
 #include "infolerp/upsample/upsampler.hpp"
 #include "support/demo_clusters.hpp"
 #include "support/demo_upsample.hpp"
+#include "support/small_demo_scene.hpp"
 #include "support/thread_pool.hpp"
 
 // The counter of support/allocation_counter.hpp, which test_upsampler.cpp includes for this
@@ -35,16 +36,7 @@ constexpr std::uint32_t W = 96, H = 72;
 
 support::demo_scene& scene() {
   static const support::embree_device device;
-  static support::demo_scene s = [] {
-    support::demo_scene_options small;
-    small.sphere_slices = 24;
-    small.sphere_stacks = 12;
-    small.torus_major = 24;
-    small.torus_minor = 8;
-    auto built = support::make_demo_scene(device, small);
-    REQUIRE(built.ok());
-    return std::move(*built);
-  }();
+  static support::demo_scene s = support::make_small_demo_scene(device);
   return s;
 }
 

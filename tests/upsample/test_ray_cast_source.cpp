@@ -17,6 +17,7 @@
 #include "support/brute_force_tracer.hpp"
 #include "support/demo_clusters.hpp"
 #include "support/demo_upsample.hpp"
+#include "support/small_demo_scene.hpp"
 #include "support/procedural.hpp"
 
 namespace support = infolerp::support;
@@ -26,16 +27,7 @@ namespace {
 
 const support::demo_scene& scene() {
   static const support::embree_device device;
-  static const support::demo_scene s = [] {
-    support::demo_scene_options small;
-    small.sphere_slices = 24;
-    small.sphere_stacks = 12;
-    small.torus_major = 24;
-    small.torus_minor = 8;
-    auto built = support::make_demo_scene(device, small);
-    REQUIRE(built.ok());
-    return std::move(*built);
-  }();
+  static const support::demo_scene s = support::make_small_demo_scene(device);
   return s;
 }
 

@@ -164,7 +164,7 @@ class ray_cast_source {
     if (s.background()) return material_(s, view);
     sample_type unit = s;
     const float len = glm::length(s.normal);
-    if (len > 0.0f) unit.normal = s.normal / len;
+    if (len > 0.0f && len != 1.0f) unit.normal = s.normal / len;  // a unit normal: dividing by 1 keeps its bits
     return material_(unit, view);
   }
 
