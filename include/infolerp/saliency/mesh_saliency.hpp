@@ -77,17 +77,17 @@ struct mesh_saliency {
 
 namespace detail {
 // One level of Lee's normalisation (see the top of the file): s receives S_i = |G(σ_lo) − G(σ_hi)|
-// per vertex (0 where unused); returns the factor N(S_i) = s · factor, or 0 when the level adds
+// per vertex (0 where unused) from avg[k · L + u] (L = avg.size() / P); returns the factor N(S_i) = s · factor, or 0 when the level adds
 // nothing (flat: its range below `floor`, or so small that 1/range overflows). is_max: scratch of
 // V entries. O(V + T), serial.
 template <class M>
 double normalise_level(const M& m, const vertex_points& grid, const std::vector<char>& used, const std::vector<double>& avg,
                        std::size_t lo, std::size_t hi, double floor, std::vector<double>& s, std::vector<char>& is_max) {
-  const std::size_t nv = used.size(), P = grid.x.size();
+  const std::size_t nv = used.size(), P = grid.x.size(), L = avg.size() / P;
   s.assign(nv, 0.0);
   double mx = 0.0;
   for (std::size_t k = 0; k < P; ++k) {
-    s[grid.id[k]] = std::abs(avg[lo * P + k] - avg[hi * P + k]);
+    s[grid.id[k]] = std::abs(avg[k * L + lo] - avg[k * L + hi]);
     mx = std::max(mx, s[grid.id[k]]);
   }
   const double range = std::max(mx, floor);
@@ -107,8 +107,8 @@ double normalise_level(const M& m, const vertex_points& grid, const std::vector<
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
       if (a == b) continue;
-      if (s[a] <= s[b] + tie) is_max[a] = 0;
-      if (s[b] <= s[a] + tie) is_max[b] = 0;
+      is_max[a] &= static_cast<char>(s[a] > s[b] + tie);  // selects, not branches (unpredictable)
+      is_max[b] &= static_cast<char>(s[b] > s[a] + tie);
     }
   }
   double sum_max = 0.0;
