@@ -183,12 +183,13 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
-  // Large groupings (the finest: all the points) run through exec; the smaller ones serially
-  // (their parallel phases cost more in barriers than they gain).
+  // Groupings of 2^19 points or more (at 1.2M triangles the finest alone) run through exec; the
+  // smaller ones serially: their ~10 parallel phases cost more in barriers than they gain when
+  // other processes share the cores (at 185k and 337k points 2-3x the serial time at a load of 5).
   serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
     const vertex_points& grouped = u == 0 ? pts : proxies[u - 1].points;
-    if (grouped.x.size() >= (std::size_t{1} << 17))
+    if (grouped.x.size() >= (std::size_t{1} << 19))
       proxies[u] = make_proxy_cells(exec, grouped, sigma[u] / cells_per_sigma);
     else
       proxies[u] = make_proxy_cells(serial, grouped, sigma[u] / cells_per_sigma);
