@@ -377,6 +377,22 @@ TEST_CASE("saliency proxy: the cell grouping and its merge of sorted runs are th
       ++i;
     }
     CHECK(off == 0);
+    // Neighbour lists against the map: per cell, the occupied cells among the 27 around it, in
+    // key order (the walk's order).
+    std::map<std::array<std::int64_t, 3>, std::uint32_t> index;
+    for (const auto& [key, sums] : cells) index.emplace(key, static_cast<std::uint32_t>(index.size()));
+    std::size_t wrong_lists = 0;
+    for (const auto& [key, at] : index) {
+      std::vector<std::uint32_t> want;
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy)
+          for (std::int64_t dz = -1; dz <= 1; ++dz)
+            if (auto it = index.find({key[0] + dx, key[1] + dy, key[2] + dz}); it != index.end()) want.push_back(it->second);
+      std::sort(want.begin(), want.end());
+      const std::vector<std::uint32_t> got(ref.near.begin() + ref.near_start[at], ref.near.begin() + ref.near_start[at + 1]);
+      wrong_lists += got == want ? 0 : 1;
+    }
+    CHECK(wrong_lists == 0);
     for (unsigned workers : {2u, 3u}) {
       infolerp::support::thread_pool_executor pool{workers};
       const auto par = infolerp::detail::make_proxy_cells(pool, pts, 0.7);

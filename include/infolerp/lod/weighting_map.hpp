@@ -54,6 +54,21 @@ struct weighting_map_options {
   double proxy_cells_per_sigma = 4.0;   // proxy: cells per σ_s along an axis (accuracy against time)
 };
 
+namespace detail {
+// smooth_vertex_values over the referenced points already gathered (grid: values at the
+// referenced vertices); the other vertices keep their value.
+template <class E>
+std::vector<double> smooth_points(E& exec, const vertex_points& grid, std::span<const double> values, double sigma,
+                                  std::size_t grain, double proxy_cells_per_sigma) {
+  const std::vector<double> avg = proxy_cells_per_sigma > 0.0
+                                      ? proxy_gaussian_averages(exec, grid, {sigma}, proxy_cells_per_sigma, grain)
+                                      : exact_gaussian_averages(exec, grid, {sigma}, grain);
+  std::vector<double> out(values.begin(), values.end());
+  for (std::size_t k = 0; k < grid.id.size(); ++k) out[grid.id[k]] = avg[k];
+  return out;
+}
+}  // namespace detail
+
 // Amplification step alone (step 3), in place over the corner values: values >= the
 // percentile-th percentile (nearest rank over the sorted values) are multiplied by lambda.
 // Preconditions: finite values, percentile in [0, 100]. O(n log n), allocation O(n).
@@ -76,13 +91,8 @@ inline void amplify_weights(std::span<double> values, double percentile, double 
 template <class M, class E = serial_executor>
 std::vector<double> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
                                          std::size_t grain = 1, double proxy_cells_per_sigma = 0.0) {
-  const detail::vertex_points grid = detail::referenced_points(m, detail::referenced_vertices(m), values);
-  const std::vector<double> avg = proxy_cells_per_sigma > 0.0
-                                      ? detail::proxy_gaussian_averages(exec, grid, {sigma}, proxy_cells_per_sigma, grain)
-                                      : detail::exact_gaussian_averages(exec, grid, {sigma}, grain);
-  std::vector<double> out(values.begin(), values.end());
-  for (std::size_t k = 0; k < grid.id.size(); ++k) out[grid.id[k]] = avg[k];
-  return out;
+  return detail::smooth_points(exec, detail::referenced_points(m, detail::referenced_vertices(m), values), values, sigma,
+                               grain, proxy_cells_per_sigma);
 }
 
 // The weighting map: 3 weights per triangle (corner order), every one finite and > 0 when some
@@ -112,13 +122,10 @@ result<std::vector<double>> weighting_map(const M& m, std::span<const double> sa
     return make_error(errc::bad_parameter, no_element, "amplify_percentile ", opt.amplify_percentile, " must be in [0, 100]");
   if (!(opt.amplification >= 1.0) || !std::isfinite(opt.amplification))
     return make_error(errc::bad_parameter, no_element, "amplification ", opt.amplification, " must be >= 1 and finite");
-  if (opt.smoothing_method != saliency_method::automatic && opt.smoothing_method != saliency_method::exact &&
-      opt.smoothing_method != saliency_method::proxy)
-    return make_error(errc::bad_parameter, no_element, "weighting map smoothing_method ", static_cast<int>(opt.smoothing_method),
-                      " is not automatic, exact or proxy");
-  if (!(opt.proxy_cells_per_sigma > 0.0) || !std::isfinite(opt.proxy_cells_per_sigma))
-    return make_error(errc::bad_parameter, no_element, "weighting map proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
-                      " must be positive and finite");
+  if (status s = detail::check_saliency_method(opt.smoothing_method, opt.proxy_cells_per_sigma, "weighting map",
+                                               "smoothing_method");
+      !s.ok())
+    return s;
   std::vector<double> smoothed(saliency.begin(), saliency.end());
   if (opt.smoothing_scale > 0.0) {
     const double diag = mesh_bounds(m).diagonal();
@@ -126,15 +133,12 @@ result<std::vector<double>> weighting_map(const M& m, std::span<const double> sa
     if (!(sigma * sigma >= std::numeric_limits<double>::min()) || !std::isfinite(16.0 * sigma * sigma))
       return make_error(diag > 0.0 ? errc::bad_parameter : errc::degenerate_triangle, no_element, "smoothing sigma ",
                         sigma, " (smoothing_scale x epsilon x bounding-box diagonal) is outside double precision");
-    std::size_t referenced = 0;
-    for (const char u : detail::referenced_vertices(m)) referenced += u ? 1 : 0;
-    const bool proxy = opt.smoothing_method == saliency_method::proxy ||
-                       (opt.smoothing_method == saliency_method::automatic && referenced >= opt.exact_below);
-    if (proxy && !(diag * opt.proxy_cells_per_sigma / sigma < detail::proxy_max_cells))
-      return make_error(errc::bad_parameter, no_element, "weighting map proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
-                        " makes proxy cells of ", sigma / opt.proxy_cells_per_sigma, ", more than ", detail::proxy_max_cells,
-                        " along the bounding-box diagonal ", diag);
-    smoothed = smooth_vertex_values(m, saliency, sigma, exec, opt.grain, proxy ? opt.proxy_cells_per_sigma : 0.0);
+    const detail::vertex_points grid = detail::referenced_points(m, detail::referenced_vertices(m), saliency);
+    const auto method = detail::choose_saliency_method(opt.smoothing_method, grid.id.size(), opt.exact_below,
+                                                      opt.proxy_cells_per_sigma, sigma, diag, "weighting map");
+    if (!method.ok()) return method.error();
+    const bool proxy = *method == saliency_method::proxy;
+    smoothed = detail::smooth_points(exec, grid, saliency, sigma, opt.grain, proxy ? opt.proxy_cells_per_sigma : 0.0);
   }
   auto local = cluster_localized_saliency(m, std::span<const double>(smoothed), cluster, cluster_count);
   if (!local.ok()) return local.error();

@@ -53,8 +53,11 @@ namespace detail {
 // The shared kernel: pos(v) -> glm::dvec3, tri(t) -> glm::uvec3, indices already checked.
 template <class Pos, class Tri>
 std::vector<double> mean_curvature_kernel(std::size_t nv, std::size_t nt, Pos&& pos, Tri&& tri_of) {
-  std::vector<glm::dvec3> lap(nv, glm::dvec3(0.0)), normal(nv, glm::dvec3(0.0));
-  std::vector<double> area(nv, 0.0);
+  struct vertex_sums {  // a vertex's sums side by side: one line per corner in the scatter below
+    glm::dvec3 lap{0.0}, normal{0.0};
+    double area = 0.0;
+  };
+  std::vector<vertex_sums> sum(nv);
   for (std::size_t t = 0; t < nt; ++t) {
     const glm::uvec3 tri = tri_of(t);
     const glm::dvec3 p[3] = {pos(tri.x), pos(tri.y), pos(tri.z)};
@@ -70,19 +73,21 @@ std::vector<double> mean_curvature_kernel(std::size_t nv, std::size_t nt, Pos&& 
     for (int c = 0; c < 3; ++c) {
       const int a = (c + 1) % 3, b = (c + 2) % 3;
       const glm::dvec3 ea = p[c] - p[a], eb = p[c] - p[b];  // edges to the other corners
+      vertex_sums& v = sum[tri[c]];
       // Edge (c, a) is opposite corner b; edge (c, b) is opposite corner a.
-      lap[tri[c]] += cot[b] * ea + cot[a] * eb;
-      normal[tri[c]] += n;
+      v.lap += cot[b] * ea + cot[a] * eb;
+      v.normal += n;
       if (!obtuse)
-        area[tri[c]] += (glm::dot(ea, ea) * cot[b] + glm::dot(eb, eb) * cot[a]) / 8.0;
+        v.area += (glm::dot(ea, ea) * cot[b] + glm::dot(eb, eb) * cot[a]) / 8.0;
       else
-        area[tri[c]] += twice_area * (dots[c] < 0.0 ? 0.25 : 0.125);
+        v.area += twice_area * (dots[c] < 0.0 ? 0.25 : 0.125);
     }
   }
   std::vector<double> h(nv, 0.0);
   for (std::size_t v = 0; v < nv; ++v) {
-    const double len = glm::length(normal[v]);
-    if (area[v] > 0.0 && len > 0.0) h[v] = 0.25 * glm::dot(lap[v], normal[v] / len) / area[v];
+    const vertex_sums& a = sum[v];
+    const double len = glm::length(a.normal);
+    if (a.area > 0.0 && len > 0.0) h[v] = 0.25 * glm::dot(a.lap, a.normal / len) / a.area;
   }
   return h;
 }

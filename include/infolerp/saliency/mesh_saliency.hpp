@@ -57,6 +57,35 @@ namespace infolerp {
 // How the ball sums are computed (see the top of the file).
 enum class saliency_method { automatic, exact, proxy };
 
+namespace detail {
+// The option checks that compute_saliency and weighting_map share; who and option name the
+// caller and its method option in messages ("saliency", "method"). O(1).
+inline status check_saliency_method(saliency_method method, double cells_per_sigma, const char* who, const char* option) {
+  if (method != saliency_method::automatic && method != saliency_method::exact && method != saliency_method::proxy)
+    return make_error(errc::bad_parameter, no_element, who, " ", option, " ", static_cast<int>(method),
+                      " is not automatic, exact or proxy");
+  if (!(cells_per_sigma > 0.0) || !std::isfinite(cells_per_sigma))
+    return make_error(errc::bad_parameter, no_element, who, " proxy_cells_per_sigma ", cells_per_sigma,
+                      " must be positive and finite");
+  return {};
+}
+
+// The method taken for `referenced` points (automatic: exact below exact_below), after
+// check_saliency_method; a proxy whose finest cells (finest_sigma / cells_per_sigma) would pass
+// proxy_max_cells along the bounding-box diagonal is a bad_parameter. O(1).
+inline result<saliency_method> choose_saliency_method(saliency_method method, std::size_t referenced,
+                                                      std::size_t exact_below, double cells_per_sigma,
+                                                      double finest_sigma, double diagonal, const char* who) {
+  if (method == saliency_method::automatic)
+    method = referenced < exact_below ? saliency_method::exact : saliency_method::proxy;
+  if (method == saliency_method::proxy && !(diagonal * cells_per_sigma / finest_sigma < proxy_max_cells))
+    return make_error(errc::bad_parameter, no_element, who, " proxy_cells_per_sigma ", cells_per_sigma,
+                      " makes proxy cells of ", finest_sigma / cells_per_sigma, ", more than ", proxy_max_cells,
+                      " along the bounding-box diagonal ", diagonal);
+  return method;
+}
+}  // namespace detail
+
 struct saliency_options {
   double epsilon = 0.003;                          // ε as a fraction of the bounding-box diagonal
   std::vector<double> scales{2.0, 3.0, 4.0, 5.0, 6.0};  // σ_i = scales[i]·ε; each level uses σ_i and 2σ_i
@@ -77,17 +106,17 @@ struct mesh_saliency {
 
 namespace detail {
 // One level of Lee's normalisation (see the top of the file): s receives S_i = |G(σ_lo) − G(σ_hi)|
-// per vertex (0 where unused); returns the factor N(S_i) = s · factor, or 0 when the level adds
+// per vertex (0 where unused) from avg[k · L + u] (L = avg.size() / P); returns the factor N(S_i) = s · factor, or 0 when the level adds
 // nothing (flat: its range below `floor`, or so small that 1/range overflows). is_max: scratch of
 // V entries. O(V + T), serial.
 template <class M>
 double normalise_level(const M& m, const vertex_points& grid, const std::vector<char>& used, const std::vector<double>& avg,
                        std::size_t lo, std::size_t hi, double floor, std::vector<double>& s, std::vector<char>& is_max) {
-  const std::size_t nv = used.size(), P = grid.x.size();
+  const std::size_t nv = used.size(), P = grid.x.size(), L = avg.size() / P;
   s.assign(nv, 0.0);
   double mx = 0.0;
   for (std::size_t k = 0; k < P; ++k) {
-    s[grid.id[k]] = std::abs(avg[lo * P + k] - avg[hi * P + k]);
+    s[grid.id[k]] = std::abs(avg[k * L + lo] - avg[k * L + hi]);
     mx = std::max(mx, s[grid.id[k]]);
   }
   const double range = std::max(mx, floor);
@@ -107,8 +136,8 @@ double normalise_level(const M& m, const vertex_points& grid, const std::vector<
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
       if (a == b) continue;
-      if (s[a] <= s[b] + tie) is_max[a] = 0;
-      if (s[b] <= s[a] + tie) is_max[b] = 0;
+      is_max[a] &= static_cast<char>(s[a] > s[b] + tie);  // selects, not branches (unpredictable)
+      is_max[b] &= static_cast<char>(s[b] > s[a] + tie);
     }
   }
   double sum_max = 0.0;
@@ -150,13 +179,8 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   for (std::size_t i = 0; i < opt.scales.size(); ++i)
     if (!(opt.scales[i] > 0.0) || !std::isfinite(opt.scales[i]))
       return make_error(errc::bad_parameter, i, "saliency scale ", i, " is ", opt.scales[i], "; must be positive and finite");
-  if (opt.method != saliency_method::automatic && opt.method != saliency_method::exact &&
-      opt.method != saliency_method::proxy)
-    return make_error(errc::bad_parameter, no_element, "saliency method ", static_cast<int>(opt.method),
-                      " is not automatic, exact or proxy");
-  if (!(opt.proxy_cells_per_sigma > 0.0) || !std::isfinite(opt.proxy_cells_per_sigma))
-    return make_error(errc::bad_parameter, no_element, "saliency proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
-                      " must be positive and finite");
+  if (status s = detail::check_saliency_method(opt.method, opt.proxy_cells_per_sigma, "saliency", "method"); !s.ok())
+    return s;
   auto curv = mean_curvature(m);
   if (!curv.ok()) return curv.error();
   const bounding_box box = mesh_bounds(m);
@@ -193,14 +217,10 @@ result<mesh_saliency> compute_saliency(const M& m, const saliency_options& opt =
   const std::vector<char> used = detail::referenced_vertices(m);
   const detail::vertex_points grid = detail::referenced_points(m, used, out.curvature);
   const std::size_t P = grid.x.size();
-  out.method = opt.method == saliency_method::automatic
-                   ? (P < opt.exact_below ? saliency_method::exact : saliency_method::proxy)
-                   : opt.method;
-  if (out.method == saliency_method::proxy &&
-      !(box.diagonal() * opt.proxy_cells_per_sigma / sigma[0] < detail::proxy_max_cells))
-    return make_error(errc::bad_parameter, no_element, "saliency proxy_cells_per_sigma ", opt.proxy_cells_per_sigma,
-                      " makes proxy cells of ", sigma[0] / opt.proxy_cells_per_sigma, ", more than ",
-                      detail::proxy_max_cells, " along the bounding-box diagonal ", box.diagonal());
+  const auto method = detail::choose_saliency_method(opt.method, P, opt.exact_below, opt.proxy_cells_per_sigma, sigma[0],
+                                                    box.diagonal(), "saliency");
+  if (!method.ok()) return method.error();
+  out.method = *method;
   const std::vector<double> avg =
       out.method == saliency_method::exact
           ? detail::exact_gaussian_averages(exec, grid, sigma, opt.grain)

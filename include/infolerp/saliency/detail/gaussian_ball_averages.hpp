@@ -355,7 +355,7 @@ __attribute__((target("avx512f,avx2,fma"))) inline void gather_tile_avx512(const
 
 // Exact Gaussian-weighted averages for L ascending radii sigma[u] (ball 2σ) over the grid's
 // points (weighted ones too, vertex_points::weight), in columns 2σ_max / columns_per_ball wide.
-// Returns avg[u * P + k] for point k of g. Every pair is evaluated once (gather_tile),
+// Returns avg[k * L + u] for point k of g. Every pair is evaluated once (gather_tile),
 // tiles of span × span columns in 6 phases by (tile x mod 2, tile y mod 3): the tiles of one
 // phase write disjoint points, so they run in parallel, and every point receives its terms in
 // an order fixed by the data: identical bits for any executor, thread count and grain (tiles
@@ -402,12 +402,13 @@ std::vector<double> exact_gaussian_averages(E& exec, const vertex_points& pg, co
       }
     });
   }
+  // A point's L averages side by side: one scattered line per point.
   std::vector<double> avg(L * P);
-  exec.parallel_for(L, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t u = b; u < e; ++u)
-      for (std::size_t k = 0; k < P; ++k) {
+  for_each_chunk(exec, P, 4096, [&](std::size_t, std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      for (std::size_t u = 0; u < L; ++u) {
         const double* nk = point_sums(sums, L, k, u);
-        avg[u * P + g.src[k]] = nk[0] / nk[block_lanes];
+        avg[std::size_t{g.src[k]} * L + u] = nk[0] / nk[block_lanes];
       }
   });
   return avg;

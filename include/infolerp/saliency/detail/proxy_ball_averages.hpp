@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -37,6 +38,16 @@ struct proxy_cells {
   std::vector<std::uint32_t> near_start, near;  // per proxy: the proxies of the 27 cells around its cell
   double h = 1.0;
 };
+
+// x where x > 0, else +0, by a mask rather than a branch (the compilers kept a branch for
+// `x > 0 ? x : 0`, mispredicted about half the time in the blend below).
+inline double positive_part(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits &= std::uint64_t{0} - static_cast<std::uint64_t>(x > 0.0);
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
 
 // Sorted runs of v ([k·run, (k+1)·run) each ascending) merged in pairs through exec, each round's
 // merges in parallel. The elements must be distinct (or equal only when identical), so the
@@ -116,39 +127,52 @@ proxy_cells make_proxy_cells(E& exec, const vertex_points& pts, double h) {
   // Neighbour cells: for each of the 9 (x, y) offsets the three z neighbours are consecutive
   // keys, and the queried keys grow with the proxy's key, so one pointer per offset walks the keys
   // (O(9·proxies) instead of a search per neighbour); each chunk of cells starts its pointers by
-  // a search, and the chunks' lists are joined in order.
+  // a search, and the chunks' lists are joined in order. A sentinel key ends the walks, and the up
+  // to three cells of an offset are taken by counting, not branching (the branches were
+  // mispredicted about once per offset).
   constexpr std::uint64_t one_x = std::uint64_t{1} << 42, one_y = std::uint64_t{1} << 21;
   std::uint64_t offset[9];
   for (int o = 0; o < 9; ++o) offset[o] = static_cast<std::uint64_t>(o / 3) * one_x + static_cast<std::uint64_t>(o % 3) * one_y;
   const std::uint64_t centre = one_x + one_y + 1;  // key + offset[o] − centre: the cell below in z
+  keys.push_back(std::numeric_limits<std::uint64_t>::max());
   const std::size_t cell_chunks = chunk_count(cells, chunk);
-  std::vector<std::vector<std::uint32_t>> near_of(cell_chunks), count_of(cell_chunks);
+  std::vector<std::vector<std::uint32_t>> near_of(cell_chunks);
+  c.near_start.assign(cells + 1, 0);  // counts first, at i + 1
   for_each_chunk(exec, cells, chunk, [&](std::size_t ch, std::size_t cb, std::size_t ce) {
     std::size_t at[9];
+    const auto end = keys.begin() + static_cast<std::ptrdiff_t>(cells);
     for (int o = 0; o < 9; ++o)
-      at[o] = static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), keys[cb] + offset[o] - centre) - keys.begin());
+      at[o] = static_cast<std::size_t>(std::lower_bound(keys.begin(), end, keys[cb] + offset[o] - centre) - keys.begin());
+    std::vector<std::uint32_t>& out = near_of[ch];
+    out.resize(27 * (ce - cb));
+    std::size_t n = 0;
     for (std::size_t i = cb; i < ce; ++i) {
-      const std::size_t before = near_of[ch].size();
+      const std::size_t before = n;
       for (int o = 0; o < 9; ++o) {
         const std::uint64_t first = keys[i] + offset[o] - centre;
-        std::size_t& p = at[o];
-        while (p < cells && keys[p] < first) ++p;
-        for (std::size_t j = p; j < cells && keys[j] <= first + 2; ++j) near_of[ch].push_back(static_cast<std::uint32_t>(j));
+        std::size_t p = at[o];
+        while (keys[p] < first) ++p;
+        at[o] = p;
+        for (int z = 0; z < 3; ++z) {
+          out[n] = static_cast<std::uint32_t>(p);
+          const std::size_t in = keys[p] <= first + 2 ? 1 : 0;
+          n += in, p += in;
+        }
       }
-      count_of[ch].push_back(static_cast<std::uint32_t>(near_of[ch].size() - before));
+      c.near_start[i + 1] = static_cast<std::uint32_t>(n - before);
     }
+    out.resize(n);
   });
-  c.near_start.reserve(cells + 1);
-  c.near_start.push_back(0);
-  for (std::size_t ch = 0; ch < cell_chunks; ++ch) {
-    c.near.insert(c.near.end(), near_of[ch].begin(), near_of[ch].end());
-    for (const std::uint32_t n : count_of[ch]) c.near_start.push_back(c.near_start.back() + n);
-  }
+  for (std::size_t i = 0; i < cells; ++i) c.near_start[i + 1] += c.near_start[i];
+  c.near.resize(c.near_start[cells]);
+  for_each_chunk(exec, cells, chunk, [&](std::size_t ch, std::size_t cb, std::size_t) {
+    std::copy(near_of[ch].begin(), near_of[ch].end(), c.near.begin() + c.near_start[cb]);
+  });
   return c;
 }
 
 // Approximate averages for L ascending radii sigma[u] (see the top of the file), in the layout of
-// exact_gaussian_averages: avg[u * P + k] for point k of pts. cells_per_sigma > 0, with
+// exact_gaussian_averages: avg[k * L + u] for point k of pts. cells_per_sigma > 0, with
 // (extent of pts) · cells_per_sigma / sigma[0] below proxy_max_cells.
 template <class E>
 std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, const std::vector<double>& sigma,
@@ -159,12 +183,13 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
-  // Large groupings (the finest: all the points) run through exec; the smaller ones serially
-  // (their parallel phases cost more in barriers than they gain).
+  // Groupings of 2^19 points or more (at 1.2M triangles the finest alone) run through exec; the
+  // smaller ones serially: their ~10 parallel phases cost more in barriers than they gain when
+  // other processes share the cores (at 185k and 337k points 2-3x the serial time at a load of 5).
   serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
     const vertex_points& grouped = u == 0 ? pts : proxies[u - 1].points;
-    if (grouped.x.size() >= (std::size_t{1} << 17))
+    if (grouped.x.size() >= (std::size_t{1} << 19))
       proxies[u] = make_proxy_cells(exec, grouped, sigma[u] / cells_per_sigma);
     else
       proxies[u] = make_proxy_cells(serial, grouped, sigma[u] / cells_per_sigma);
@@ -194,27 +219,33 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
     });
   }
   const std::vector<std::uint32_t>& order = proxies[0].order;
-  std::vector<double> sx(P), sy(P), sz(P);
-  for (std::size_t i = 0; i < P; ++i) sx[i] = pts.x[order[i]], sy[i] = pts.y[order[i]], sz[i] = pts.z[order[i]];
-  std::vector<double> avg(L * P);
+  // Per chunk of points: the L averages of each point side by side in a small buffer, then
+  // copied to the point's L adjacent entries (one scattered line per point instead of L).
+  // Outside h a proxy's weight is 0 (positive_part: the same sums without a branch).
+  std::vector<double> avg(P * L);
   constexpr std::size_t chunk = 4096;
-  exec.parallel_for((P + chunk - 1) / chunk, 1, [&](std::size_t b, std::size_t e) {
+  for_each_chunk(exec, P, chunk, [&](std::size_t, std::size_t b, std::size_t e) {
+    std::vector<double> blended((e - b) * L), sx(e - b), sy(e - b), sz(e - b);
+    for (std::size_t i = b; i < e; ++i) sx[i - b] = pts.x[order[i]], sy[i - b] = pts.y[order[i]], sz[i - b] = pts.z[order[i]];
     for (std::size_t u = 0; u < L; ++u) {
       const proxy_cells& c = proxies[u];
       const std::array<double, 4>* ap = at_proxy[u].data();
       const double inv_h2 = 1.0 / (c.h * c.h);
-      for (std::size_t i = b * chunk; i < std::min(P, e * chunk); ++i) {
+      for (std::size_t i = b; i < e; ++i) {
         const std::uint32_t own = cell_of[u][i];
         double num = 0.0, den = 0.0;
         for (std::uint32_t n = c.near_start[own]; n < c.near_start[own + 1]; ++n) {
           const std::array<double, 4>& q = ap[c.near[n]];
-          const double dx = q[0] - sx[i], dy = q[1] - sy[i], dz = q[2] - sz[i];
-          const double t = 1.0 - (dx * dx + dy * dy + dz * dz) * inv_h2;
-          if (t > 0.0) num += t * t * q[3], den += t * t;
+          const double dx = q[0] - sx[i - b], dy = q[1] - sy[i - b], dz = q[2] - sz[i - b];
+          const double t = positive_part(1.0 - (dx * dx + dy * dy + dz * dz) * inv_h2);
+          num += t * t * q[3], den += t * t;
         }
-        avg[u * P + order[i]] = den > 0.0 ? num / den : ap[own][3];
+        blended[(i - b) * L + u] = den > 0.0 ? num / den : ap[own][3];
       }
     }
+    for (std::size_t i = b; i < e; ++i)
+      std::copy_n(blended.begin() + static_cast<std::ptrdiff_t>((i - b) * L), L,
+                  avg.begin() + static_cast<std::ptrdiff_t>(std::size_t{order[i]} * L));
   });
   return avg;
 }
