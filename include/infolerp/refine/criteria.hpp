@@ -10,9 +10,7 @@
 //    to RND too keeps RND from spending samples below pixel size, and gives the three the same
 //    floor). The area comes from the view's pinhole projection (refinement_frame::projection,
 //    which progressive_refiner sets for a pinhole_camera); without one, the count of pixel
-//    centres the triangle covers stands in. That count is no bound on size: a sliver under one
-//    pixel centre counts 1 however small it is, so with min_pixels 1 a criterion could send one
-//    pixel's triangle down twenty levels, to corners that nearly coincide in float.
+//    centres the triangle covers stands in (no bound on size: a sliver under one centre counts 1).
 //  - NLD_OS ranks its candidates: triangles above the `always_refine_fraction` of the image
 //    first (largest first), then by S (largest first), ties by id; it takes the first R.
 //  - NLD_IS is a best-first walk of the image quadtree: the quadrant with the largest S (over
@@ -25,23 +23,19 @@
 //    last batch may overshoot by its own requests; the paper gives no value, so the default is
 //    none).
 //  - NLD_IS does not split a triangle whose corner colours differ by less than
-//    `display_quantum` in every channel (default half a step of an 8-bit display of values in
-//    [0, 1]): its interpolation shows one displayed value, and a quadrant's S is high there only
-//    because its corners fall on other triangles (a silhouette, a neighbour across a shadow
-//    edge). As §4.1's large-triangle rule does for NLD_OS, triangles covering more than
-//    `always_refine_fraction` of the image are exempt, so a feature that no vertex sees yet is
-//    still looked for inside large triangles; in smaller ones it is left unfound, as NLD_OS
-//    leaves it. For an sRGB display the darkest steps are 12.92 times finer: pass a smaller
-//    quantum there. 0 turns the rule off (the paper's NLD_IS).
+//    `display_quantum` in every channel (default half an 8-bit step of values in [0, 1]; smaller
+//    for sRGB's dark steps; 0: the paper's NLD_IS): it shows one displayed value, and its
+//    quadrants' S is high only because their corners fall on other triangles. Triangles above
+//    `always_refine_fraction` of the image are exempt (§4.1), so a feature no vertex sees yet is
+//    still looked for in large triangles; in smaller ones it is left unfound, as NLD_OS leaves it.
 //  - No criterion selects a triangle whose split would give children with coinciding float
 //    corners (subdivision_mesh::splittable).
 //  - RND draws pixels uniformly (splitmix64 from `seed`, deterministic); a pixel showing a
 //    qualifying triangle selects it. A batch draws until it has R triangles or made 8·R draws;
 //    RND stops for good after `rnd_point_fraction` of the pixel count has been drawn.
-//  - NLD_OS with a random pass (§7, future work: "merge NLD_OS with a random pass", to find
-//    discontinuities that no vertex luminance shows yet): with `random_share` s > 0, NLD_OS takes
-//    up to R − round(s·R) triangles and RND's rule fills the batch up to R with triangles not
-//    already chosen, under RND's point budget; the criterion ends when both find nothing.
+//  - NLD_OS with a random pass (§7's future work): with `random_share` s > 0, NLD_OS takes up to
+//    R − round(s·R) triangles and RND's rule fills the batch with others, under RND's point
+//    budget; the criterion ends when both find nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
