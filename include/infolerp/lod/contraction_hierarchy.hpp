@@ -237,11 +237,12 @@ class collapse_mesh {
       if (vx[e.b].stamp != s) vx[e.b].stamp = s, out.push_back(e.b);
     }
   }
-  // The §III.C validity tests for u → v (see the top of the file). When they pass, ring(u) is in
-  // ring_u and ring(v) in ring_v, the latter marked with stamp_now.
-  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
+  // The §III.C validity tests for u → v (see the top of the file). Afterwards ring(u) is in
+  // ring_u (already there when ring_u_known); when they pass, ring(v) is in ring_v, marked with
+  // stamp_now.
+  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos, bool ring_u_known = false) {
     std::uint32_t opp[2] = {nil, nil}, k = 0;  // the triangles on the edge and their third corners
-    ring(u, ring_u);
+    if (!ring_u_known) ring(u, ring_u);
     for (const fan_entry& e : triangles(u))
       if (e.a == v || e.b == v) {
         if (k < 2) opp[k] = e.a == v ? e.b : e.a;
@@ -505,19 +506,19 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     for (std::uint32_t x : cm.ring_v) if (owner[x] != c) return false;
     return true;
   };
-  auto valid = [&](std::uint32_t u, std::uint32_t v) {
-    return cm.can_collapse(u, v, opt.min_normal_cos) && (!local_phase || local_to_cluster(owner[u]));
+  auto valid = [&](std::uint32_t u, std::uint32_t v, bool ring_u_known = false) {
+    return cm.can_collapse(u, v, opt.min_normal_cos, ring_u_known) && (!local_phase || local_to_cluster(owner[u]));
   };
-  // u's cheapest contraction failed the tests: queue its cheapest valid one, or drop u until its
-  // neighbourhood changes (or the next round).
+  // u's cheapest contraction failed the tests (which left ring(u) in ring_u, unchanged by the
+  // tests below): queue its cheapest valid one, or drop u until its neighbourhood changes (or the
+  // next round).
   auto requeue = [&](std::uint32_t u, std::uint32_t failed) {
-    cm.ring(u, candidates);
     ranked.clear();
-    for (std::uint32_t v : candidates)
+    for (std::uint32_t v : cm.ring_u)
       if (v != failed) ranked.push_back({cost(u, v), v});
     std::sort(ranked.begin(), ranked.end());
     for (const auto& [c, v] : ranked)
-      if (valid(u, v)) return heap.set({c, u, v}), void(cm.vx[u].fallback = 1);
+      if (valid(u, v, true)) return heap.set({c, u, v}), void(cm.vx[u].fallback = 1);
     heap.erase(u);
   };
   while (live > floor_count) {
