@@ -8,7 +8,9 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <span>
+#include <tuple>
 #include <vector>
 #include <catch2/catch.hpp>
 #include "infolerp/lod/contraction_hierarchy.hpp"
@@ -368,6 +370,38 @@ TEST_CASE("hierarchy on a bumpy plane with holes: no flip, boundary kept, manifo
   CHECK(flips == 0);
   CHECK(off_boundary == 0);
   CHECK(non_manifold == 0);
+}
+
+TEST_CASE("hierarchy: the vertex heap keeps the (cost, u, v) order of a std::set under updates", "[lod]") {
+  // Few distinct costs, so that most entries tie on cost (as zero-cost coplanar contractions do).
+  std::mt19937 rng(7);
+  for (const std::uint32_t n : {1u, 5u, 64u, 3000u}) {
+    detail::vertex_heap heap;
+    heap.reset(n);
+    std::vector<detail::collapse_entry> entry(n);
+    std::vector<char> in(n, 0);
+    auto same = [](const detail::collapse_entry& a, const detail::collapse_entry& b) { return !(a < b) && !(b < a); };
+    std::set<std::tuple<double, std::uint32_t, std::uint32_t>> ref;
+    for (int step = 0; step < 20000; ++step) {
+      const auto u = static_cast<std::uint32_t>(rng() % n);
+      if (in[u]) ref.erase({entry[u].cost, u, entry[u].v});
+      if (const auto op = rng() % 8; op == 0) {
+        heap.erase(u), in[u] = 0;
+      } else if (op == 1 && !ref.empty()) {  // pop the top, as the build does
+        if (in[u]) ref.insert({entry[u].cost, u, entry[u].v});
+        const auto [c, top_u, top_v] = *ref.begin();
+        REQUIRE(same(heap.top(), {c, top_u, top_v}));
+        heap.erase(top_u), in[top_u] = 0, ref.erase(ref.begin());
+      } else {
+        entry[u] = {static_cast<double>(rng() % 4), u, static_cast<std::uint32_t>(rng() % 3)};
+        heap.set(entry[u]), in[u] = 1, ref.insert({entry[u].cost, u, entry[u].v});
+      }
+      REQUIRE(heap.empty() == ref.empty());
+      if (!ref.empty()) REQUIRE(same(heap.top(), {std::get<0>(*ref.begin()), std::get<1>(*ref.begin()), std::get<2>(*ref.begin())}));
+      if (in[u]) REQUIRE((heap.find(u) && same(*heap.find(u), entry[u])));
+      else REQUIRE(heap.find(u) == nullptr);
+    }
+  }
 }
 
 TEST_CASE("hierarchy: a non-manifold edge is refused and named", "[lod]") {

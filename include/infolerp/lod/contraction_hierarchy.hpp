@@ -142,9 +142,9 @@ struct collapse_entry {
   }
 };
 
-// Binary min-heap of collapse entries, at most one per vertex, with each vertex's slot known so
+// 4-ary min-heap of collapse entries, at most one per vertex, with each vertex's slot known so
 // that its entry is replaced in place: O(log V) per update, no stale entries, no allocation
-// after reset.
+// after reset. Four children side by side: half the levels, and cache misses, of a binary heap.
 class vertex_heap {
  public:
   static constexpr std::uint32_t none = invalid_id;
@@ -182,13 +182,15 @@ class vertex_heap {
   void put(std::uint32_t i, const collapse_entry& e) { heap_[i] = e, slot_[e.u] = i; }
   void place(std::uint32_t i) {  // sift heap_[i] up or down
     const collapse_entry e = heap_[i];
-    while (i > 0 && e < heap_[(i - 1) / 2]) put(i, heap_[(i - 1) / 2]), i = (i - 1) / 2;
+    while (i > 0 && e < heap_[(i - 1) / 4]) put(i, heap_[(i - 1) / 4]), i = (i - 1) / 4;
     for (;;) {
-      std::uint32_t c = 2 * i + 1;
-      if (c >= heap_.size()) break;
-      if (c + 1 < heap_.size() && heap_[c + 1] < heap_[c]) ++c;
+      const std::size_t first = 4 * std::size_t{i} + 1, end = std::min(first + 4, heap_.size());
+      if (first >= end) break;
+      std::size_t c = first;
+      for (std::size_t k = first + 1; k < end; ++k)
+        if (heap_[k] < heap_[c]) c = k;
       if (!(heap_[c] < e)) break;
-      put(i, heap_[c]), i = c;
+      put(i, heap_[c]), i = static_cast<std::uint32_t>(c);
     }
     put(i, e);
   }
@@ -208,43 +210,51 @@ struct fan_entry {
 class collapse_mesh {
  public:
   static constexpr std::uint32_t nil = invalid_id;
-  std::vector<glm::vec3> pos;  // as given (exact in double)
-  std::vector<char> alive, boundary;
-  std::vector<fan_entry> fan;                     // the slices
-  std::vector<std::uint32_t> first, count, room;  // vertex x's slice: fan[first[x] ..+ count[x]), room[x] long
-  std::vector<std::uint32_t> stamp, last_touch, killed_by;
+  // What a contraction reads of each vertex in its 2-ring, in one record (32 bytes: two per
+  // cache line) rather than in one array per field, since the global cost order visits the mesh
+  // at random. fallback: the vertex's heap entry is not its cheapest contraction (refused).
+  struct alignas(32) vertex_state {
+    glm::vec3 pos;  // as given (exact in double)
+    std::uint32_t stamp = 0, first = 0, count = 0, last_touch = invalid_id;  // slice: fan[first ..+ count)
+    std::uint8_t alive = 0, boundary = 0, fallback = 0;
+  };
+  std::vector<vertex_state> vx;
+  std::vector<fan_entry> fan;        // the slices
+  std::vector<std::uint32_t> room;   // vertex x's slice has room[x] entries
+  std::vector<std::uint32_t> killed_by;
   std::vector<quadric> q;
   std::uint32_t stamp_now = 0;
   std::vector<std::uint32_t> ring_u, ring_v;
 
-  [[nodiscard]] glm::dvec3 at(std::uint32_t x) const { return glm::dvec3(pos[x]); }
-  [[nodiscard]] std::span<const fan_entry> triangles(std::uint32_t x) const { return {fan.data() + first[x], count[x]}; }
+  [[nodiscard]] glm::dvec3 at(std::uint32_t x) const { return glm::dvec3(vx[x].pos); }
+  [[nodiscard]] std::span<const fan_entry> triangles(std::uint32_t x) const { return {fan.data() + vx[x].first, vx[x].count}; }
   // Distinct neighbours of x into out, each marked with a fresh stamp.
   void ring(std::uint32_t x, std::vector<std::uint32_t>& out) {
     out.clear();
     const std::uint32_t s = ++stamp_now;
     for (const fan_entry& e : triangles(x)) {
-      if (stamp[e.a] != s) stamp[e.a] = s, out.push_back(e.a);
-      if (stamp[e.b] != s) stamp[e.b] = s, out.push_back(e.b);
+      if (vx[e.a].stamp != s) vx[e.a].stamp = s, out.push_back(e.a);
+      if (vx[e.b].stamp != s) vx[e.b].stamp = s, out.push_back(e.b);
     }
   }
-  // The §III.C validity tests for u → v (see the top of the file). When they pass, ring(u) is in
-  // ring_u and ring(v) in ring_v, the latter marked with stamp_now.
-  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos) {
+  // The §III.C validity tests for u → v (see the top of the file). Afterwards ring(u) is in
+  // ring_u (already there when ring_u_known); when they pass, ring(v) is in ring_v, marked with
+  // stamp_now.
+  bool can_collapse(std::uint32_t u, std::uint32_t v, double min_cos, bool ring_u_known = false) {
     std::uint32_t opp[2] = {nil, nil}, k = 0;  // the triangles on the edge and their third corners
-    ring(u, ring_u);
+    if (!ring_u_known) ring(u, ring_u);
     for (const fan_entry& e : triangles(u))
       if (e.a == v || e.b == v) {
         if (k < 2) opp[k] = e.a == v ? e.b : e.a;
         ++k;
       }
     if (k == 0 || k > 2) return false;
-    if (boundary[u] && !(boundary[v] && k == 1)) return false;
+    if (vx[u].boundary && !(vx[v].boundary && k == 1)) return false;
     ring(v, ring_v);
     const std::uint32_t sv = stamp_now;  // ring(v) carries this stamp
     // Link condition: a common neighbour must be opposite the edge.
     for (std::uint32_t x : ring_u)
-      if (x != v && stamp[x] == sv && x != opp[0] && x != opp[1]) return false;
+      if (x != v && vx[x].stamp == sv && x != opp[0] && x != opp[1]) return false;
     for (const fan_entry& e : triangles(u)) {
       if (e.a == v || e.b == v) continue;
       const std::uint32_t j = e.corner % 3;
@@ -265,8 +275,8 @@ class collapse_mesh {
   std::uint8_t collapse(std::uint32_t u, std::uint32_t v, std::uint32_t order) {
     std::uint8_t removed = 0;
     std::uint32_t kept = 0;
-    const std::uint32_t fu = first[u];
-    for (std::uint32_t i = 0; i < count[u]; ++i) {
+    const std::uint32_t fu = vx[u].first;
+    for (std::uint32_t i = 0; i < vx[u].count; ++i) {
       const fan_entry e = fan[fu + i];
       const std::uint32_t t = e.corner / 3;
       if (e.a == v || e.b == v) {
@@ -279,27 +289,27 @@ class collapse_mesh {
       fan[fu + kept++] = e;
     }
     // u's surviving triangles join v's slice.
-    const std::uint32_t need = count[v] + kept;
+    const std::uint32_t need = vx[v].count + kept;
     if (need > room[v]) {
       const auto end = static_cast<std::uint32_t>(fan.size());
       fan.resize(fan.size() + need + need / 2);
-      std::copy_n(fan.begin() + first[v], count[v], fan.begin() + end);
-      first[v] = end, room[v] = need + need / 2;
+      std::copy_n(fan.begin() + vx[v].first, vx[v].count, fan.begin() + end);
+      vx[v].first = end, room[v] = need + need / 2;
     }
-    std::copy_n(fan.begin() + fu, kept, fan.begin() + first[v] + count[v]);
-    count[v] = need, count[u] = 0;
-    alive[u] = 0;
+    std::copy_n(fan.begin() + fu, kept, fan.begin() + vx[v].first + vx[v].count);
+    vx[v].count = need, vx[u].count = 0;
+    vx[u].alive = 0;
     q[v] += q[u];
     return removed;
   }
 
  private:
   fan_entry* find(std::uint32_t x, std::uint32_t t) {  // triangle t in x's slice
-    fan_entry* e = fan.data() + first[x];
+    fan_entry* e = fan.data() + vx[x].first;
     while (e->corner / 3 != t) ++e;
     return e;
   }
-  void drop(std::uint32_t x, std::uint32_t t) { *find(x, t) = fan[first[x] + --count[x]]; }  // order within a slice is free
+  void drop(std::uint32_t x, std::uint32_t t) { *find(x, t) = fan[vx[x].first + --vx[x].count]; }  // order within a slice is free
   void rename(std::uint32_t x, std::uint32_t t, std::uint32_t from, std::uint32_t to) {
     fan_entry* e = find(x, t);
     (e->a == from ? e->a : e->b) = to;
@@ -352,13 +362,9 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   const double floor_weight = mean_weight > 0.0 ? opt.weight_floor * mean_weight : 1.0;
   const auto weight = [&](std::size_t k) { return mean_weight > 0.0 ? std::max(weights[k], floor_weight) : 1.0; };
   detail::collapse_mesh cm;
-  cm.pos.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) cm.pos[v] = mesh_position(m, v);
+  cm.vx.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) cm.vx[v].pos = mesh_position(m, v);
   cm.killed_by.assign(nt, invalid_id);
-  cm.alive.assign(nv, 0);
-  cm.boundary.assign(nv, 0);
-  cm.stamp.assign(nv, 0);
-  cm.last_touch.assign(nv, no_parent);
   cm.q.assign(nv, {});
   std::vector<std::uint32_t> owner(nv, invalid_id);
   bool repeated = false;
@@ -369,7 +375,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
       continue;
     }
     for (int j = 0; j < 3; ++j) {
-      cm.alive[f[j]] = 1;
+      cm.vx[f[j]].alive = 1;
       owner[f[j]] = cluster[t];  // last write wins: the lowest-index triangle
     }
     const glm::dvec3 p0 = cm.at(f.x), p1 = cm.at(f.y), p2 = cm.at(f.z);
@@ -398,9 +404,8 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
         const int j = static_cast<int>(c % 3);
         return detail::fan_entry{static_cast<std::uint32_t>(c), f[(j + 1) % 3], f[(j + 2) % 3]};
       },
-      cm.first, cm.fan);
-  cm.count.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) cm.count[v] = cm.first[v + 1] - cm.first[v];
+      cm.room, cm.fan);  // room holds the slice starts until the slices are final
+  for (std::size_t v = 0; v < nv; ++v) cm.vx[v].first = cm.room[v], cm.vx[v].count = cm.room[v + 1] - cm.room[v];
   // Edges (a, b), a < b, from a's triangles in ascending (a, b): more than two distinct triangles
   // is an error; one makes a boundary edge, held by a plane through it perpendicular to its
   // (lowest-index) triangle.
@@ -411,7 +416,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
       others.clear();
       auto hit = [&](std::uint32_t b, std::uint32_t t) {
         if (b <= a) return;
-        if (cm.stamp[b] != s) cm.stamp[b] = s, hits[b] = 0, edge_tri[b] = t, others.push_back(b);
+        if (cm.vx[b].stamp != s) cm.vx[b].stamp = s, hits[b] = 0, edge_tri[b] = t, others.push_back(b);
         ++hits[b];
       };
       for (const detail::fan_entry& e : cm.triangles(a)) {
@@ -426,7 +431,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
         if (hits[b] == 1) open.push_back(b);
       }
       for (std::uint32_t b : open) {
-        cm.boundary[a] = cm.boundary[b] = 1;
+        cm.vx[a].boundary = cm.vx[b].boundary = 1;
         const std::uint32_t t = edge_tri[b];
         const glm::uvec3 f = mesh_triangle(m, t);
         const glm::dvec3 fn = glm::cross(cm.at(f.y) - cm.at(f.x), cm.at(f.z) - cm.at(f.x));
@@ -446,18 +451,17 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   if (repeated)
     for (std::uint32_t v = 0; v < nv; ++v) {
       std::uint32_t kept = 0;
-      for (std::uint32_t i = 0; i < cm.count[v]; ++i) {
-        const detail::fan_entry e = cm.fan[cm.first[v] + i];
-        if (e.a != e.b && e.a != v && e.b != v) cm.fan[cm.first[v] + kept++] = e;
+      for (std::uint32_t i = 0; i < cm.vx[v].count; ++i) {
+        const detail::fan_entry e = cm.fan[cm.vx[v].first + i];
+        if (e.a != e.b && e.a != v && e.b != v) cm.fan[cm.vx[v].first + kept++] = e;
       }
-      cm.count[v] = kept;
+      cm.vx[v].count = kept;
     }
-  cm.room.assign(cm.first.begin() + 1, cm.first.end());
-  for (std::uint32_t v = 0; v < nv; ++v) cm.room[v] -= cm.first[v];
-  cm.first.pop_back();
+  for (std::uint32_t v = 0; v < nv; ++v) cm.room[v] = cm.room[v + 1] - cm.vx[v].first;
+  cm.room.pop_back();
 
   std::size_t live = 0;
-  for (std::size_t v = 0; v < nv; ++v) live += cm.alive[v] ? 1 : 0;
+  for (std::size_t v = 0; v < nv; ++v) live += cm.vx[v].alive ? 1 : 0;
   const auto floor_count = static_cast<std::size_t>(std::ceil(opt.backstop * static_cast<double>(live)));
 
   contraction_hierarchy h;
@@ -476,14 +480,13 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   heap.reset(nv);
   std::vector<std::uint32_t> candidates, joining;
   std::vector<std::pair<double, std::uint32_t>> ranked;
-  std::vector<char> fallback(nv, 0);  // the vertex's entry is not its cheapest contraction (refused)
   auto cost = [&](std::uint32_t u, std::uint32_t v) { return detail::collapse_cost(cm.q[u], cm.at(v)); };
   // u's entry from its neighbours (ring(u)).
   auto rank = [&](std::uint32_t u, const std::vector<std::uint32_t>& ring) {
     detail::collapse_entry best{std::numeric_limits<double>::infinity(), u, invalid_id};
     for (std::uint32_t v : ring)
       if (const detail::collapse_entry e{cost(u, v), u, v}; e < best) best = e;
-    fallback[u] = 0;
+    cm.vx[u].fallback = 0;
     if (best.v != invalid_id) heap.set(best);
     else heap.erase(u);
   };
@@ -494,7 +497,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   auto fill = [&] {
     heap.reset(nv);
     for (std::uint32_t x = 0; x < nv; ++x)
-      if (cm.alive[x]) set_best(x);
+      if (cm.vx[x].alive) set_best(x);
   };
   fill();
   bool progress_since_fill = false, local_phase = opt.cluster_local_first;
@@ -503,19 +506,19 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     for (std::uint32_t x : cm.ring_v) if (owner[x] != c) return false;
     return true;
   };
-  auto valid = [&](std::uint32_t u, std::uint32_t v) {
-    return cm.can_collapse(u, v, opt.min_normal_cos) && (!local_phase || local_to_cluster(owner[u]));
+  auto valid = [&](std::uint32_t u, std::uint32_t v, bool ring_u_known = false) {
+    return cm.can_collapse(u, v, opt.min_normal_cos, ring_u_known) && (!local_phase || local_to_cluster(owner[u]));
   };
-  // u's cheapest contraction failed the tests: queue its cheapest valid one, or drop u until its
-  // neighbourhood changes (or the next round).
+  // u's cheapest contraction failed the tests (which left ring(u) in ring_u, unchanged by the
+  // tests below): queue its cheapest valid one, or drop u until its neighbourhood changes (or the
+  // next round).
   auto requeue = [&](std::uint32_t u, std::uint32_t failed) {
-    cm.ring(u, candidates);
     ranked.clear();
-    for (std::uint32_t v : candidates)
+    for (std::uint32_t v : cm.ring_u)
       if (v != failed) ranked.push_back({cost(u, v), v});
     std::sort(ranked.begin(), ranked.end());
     for (const auto& [c, v] : ranked)
-      if (valid(u, v)) return heap.set({c, u, v}), void(fallback[u] = 1);
+      if (valid(u, v, true)) return heap.set({c, u, v}), void(cm.vx[u].fallback = 1);
     heap.erase(u);
   };
   while (live > floor_count) {
@@ -537,13 +540,13 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     heap.erase(e.u);
     joining.clear();  // the neighbours of u that v gains
     for (std::uint32_t x : cm.ring_u)
-      if (x != e.v && cm.stamp[x] != cm.stamp_now) joining.push_back(x);
+      if (x != e.v && cm.vx[x].stamp != cm.stamp_now) joining.push_back(x);
     // Dependencies: the last contraction that changed the fan of u, v or a neighbour of either.
     const auto order = static_cast<std::uint32_t>(h.removed.size());
     std::uint32_t parent = no_parent;
     dep_scratch.clear();
     auto note = [&](std::uint32_t x) {
-      const std::uint32_t j = cm.last_touch[x];
+      const std::uint32_t j = cm.vx[x].last_touch;
       if (j == no_parent) return;
       parent = parent == no_parent ? j : std::max(parent, j);
       if (h.owner[j] != owner[e.u]) dep_scratch.push_back({h.owner[j], j});
@@ -560,8 +563,8 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     h.faces_removed.push_back(gone);
     h.error.push_back(static_cast<float>(e.cost));
     h.removal_order[e.u] = order;
-    cm.last_touch[e.v] = order;
-    for (std::uint32_t x : cm.ring_u) cm.last_touch[x] = order;
+    cm.vx[e.v].last_touch = order;
+    for (std::uint32_t x : cm.ring_u) cm.vx[x].last_touch = order;
     --live;
     progress_since_fill = true;
     cm.ring(e.v, cm.ring_v);
@@ -571,7 +574,7 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
     // without an entry or with a fallback one is ranked anew: its refused contractions may pass.
     for (std::uint32_t x : cm.ring_v) {
       const detail::collapse_entry* old = heap.find(x);
-      if (!old || fallback[x] || old->v == e.u) {
+      if (!old || cm.vx[x].fallback || old->v == e.u) {
         set_best(x);
       } else if (std::find(joining.begin(), joining.end(), x) != joining.end()) {
         if (const detail::collapse_entry to_v{cost(x, e.v), x, e.v}; to_v < *old) heap.set(to_v);
@@ -593,21 +596,21 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   for (std::size_t t = 0; t < nt; ++t) ++h.triangle_offsets[cluster[t] + 1];
   for (std::uint32_t c = 0; c < cluster_count; ++c) h.triangle_offsets[c + 1] += h.triangle_offsets[c];
   {
-    std::vector<std::uint32_t> perm(nt);
-    for (std::uint32_t t = 0; t < nt; ++t) perm[t] = t;
-    const auto kill_owner = [&](std::uint32_t t) { return cm.killed_by[t] == invalid_id ? 0 : h.owner[cm.killed_by[t]]; };
-    std::sort(perm.begin(), perm.end(), [&](std::uint32_t a, std::uint32_t b) {
-      if (cluster[a] != cluster[b]) return cluster[a] < cluster[b];
-      if (kill_owner(a) != kill_owner(b)) return kill_owner(a) < kill_owner(b);
-      if (cm.killed_by[a] != cm.killed_by[b]) return cm.killed_by[a] > cm.killed_by[b];
-      return a < b;
-    });
+    // Each triangle's sort key in one record, (cluster, owner) then (~killer, t): the sort reads
+    // nothing else (~ puts the latest removal, and invalid_id, first).
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> key(nt);
+    for (std::uint32_t t = 0; t < nt; ++t) {
+      const std::uint32_t k = cm.killed_by[t], kill_owner = k == invalid_id ? 0 : h.owner[k];
+      key[t] = {std::uint64_t{cluster[t]} << 32 | kill_owner, std::uint64_t{~k} << 32 | t};
+    }
+    std::sort(key.begin(), key.end());
     h.indices.resize(3 * nt);
     h.killer.resize(nt);
     for (std::size_t k = 0; k < nt; ++k) {
-      const glm::uvec3 f = mesh_triangle(m, perm[k]);
+      const auto t = static_cast<std::uint32_t>(key[k].second);
+      const glm::uvec3 f = mesh_triangle(m, t);
       h.indices[3 * k] = f.x, h.indices[3 * k + 1] = f.y, h.indices[3 * k + 2] = f.z;
-      h.killer[k] = cm.killed_by[perm[k]];
+      h.killer[k] = cm.killed_by[t];
     }
   }
   return h;
