@@ -195,12 +195,13 @@ void check_closed_stop_points(const contraction_hierarchy& h, const local_index_
   std::vector<std::uint32_t> in(contracted_index_bound(h)), stop(h.cluster_count);
   std::vector<index_range> ranges(h.cluster_count), parts(t.part_count());
   std::vector<std::uint16_t> out(in.size());
+  const neighbour_table table = make_neighbour_table(h);
   std::mt19937 rng(5);
   std::uniform_int_distribution<std::uint32_t> at(0, static_cast<std::uint32_t>(h.contraction_count()));
   for (int k = 0; k < draws; ++k) {
     if (k % 2 == 0) {
       for (std::uint32_t& s : stop) s = at(rng);
-      match_neighbours(h, stop);
+      match_neighbours(h, table, stop);
     } else {
       std::fill(stop.begin(), stop.end(), at(rng));
     }

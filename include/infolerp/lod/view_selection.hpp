@@ -58,22 +58,6 @@ inline std::uint64_t applied_total(const contraction_hierarchy& h, std::span<con
   return n;
 }
 
-// Neighbour matching in place; returns the sweeps run (>= 1). Preconditions: stop holds one
-// entry per cluster. O(sweeps · applied cross-cluster dependencies), no allocation.
-inline std::uint32_t match_neighbours(const contraction_hierarchy& h, std::span<std::uint32_t> stop) {
-  std::uint32_t sweeps = 0;
-  for (bool changed = true; changed;) {
-    changed = false;
-    ++sweeps;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c)
-      for (std::uint32_t k = h.cross_offsets[c]; k < h.cross_offsets[c + 1] && h.cross[k].order < stop[c]; ++k) {
-        std::uint32_t& s = stop[h.cross[k].cluster];
-        if (s <= h.cross[k].needs) s = h.cross[k].needs + 1, changed = true;
-      }
-  }
-  return sweeps;
-}
-
 // Per cluster c and each other cluster c' it depends on: c's cross dependencies on c' by
 // ascending order with the running maximum of `needs`, so that matching reads the raise each
 // stop point implies by one binary search instead of one step per dependency.
@@ -104,7 +88,9 @@ inline neighbour_table make_neighbour_table(const contraction_hierarchy& h) {
   return t;
 }
 
-// match_neighbours with t = make_neighbour_table(h): the same stop points and sweeps.
+// Neighbour matching in place: every applied cross dependency of cluster c on cluster c' raises
+// the stop point of c' past the contraction it needs; sweeps until none changes. Returns the sweeps run
+// (>= 1). Preconditions: t = make_neighbour_table(h), stop one entry per cluster.
 // O(sweeps · pairs · log dependencies), no allocation.
 inline std::uint32_t match_neighbours(const contraction_hierarchy& h, const neighbour_table& t,
                                       std::span<std::uint32_t> stop) {
