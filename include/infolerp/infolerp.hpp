@@ -12,6 +12,7 @@
 #include "infolerp/saliency/mesh_saliency.hpp"           // saliency per vertex (Lee et al.)
 #include "infolerp/saliency/salient_clustering.hpp"      // salient clusters, cluster-localised saliency
 #include "infolerp/saliency/cluster_importance.hpp"      // view-dependent importance and budgets
+#include "infolerp/lod/lod_mesh.hpp"                     // mesh -> ready LOD, frames within a triangle budget
 #include "infolerp/lod/view_dependent_lod.hpp"           // per-frame saliency LOD into an index buffer
 #include "infolerp/refine/progressive_driver.hpp"        // progressive refinement (NLD_OS, NLD_IS, RND)
 #include "infolerp/upsample/upsampler.hpp"               // the I-Buffer upsampler

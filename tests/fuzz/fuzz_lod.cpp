@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::uint32_t c = 0; c < clusters; ++c) over = over || budget[c] > h->capacity(c);
   FUZZ_CHECK(s.ok() == !over);
   if (!s.ok()) return 0;
-  if (flags & 16) infolerp::match_neighbours(*h, infolerp::make_neighbour_table(*h), stop);
+  if (flags & 16) infolerp::match_neighbours(infolerp::make_neighbour_table(*h), stop);
   auto applied = [&](std::uint32_t i) { return i < stop[h->owner[i]]; };
   const bool matched = (flags & 16) != 0;
   if (matched)

@@ -58,9 +58,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::check_error(lod.error());
   if (!lod.ok()) return 0;
   FUZZ_CHECK(ref.ok());
-  // Flag 8: the count as read (counts above the capacity are refused, up to 2^64 - 1); else folded
-  // into [0, capacity + 1] so that most inputs draw a frame.
-  const std::uint64_t global = (flags & 8) ? contractions : contractions % (lod->capacity() + 2);
+  // Flag 8: the triangle budget as read (up to 2^64 - 1: the full mesh); else folded into
+  // [0, triangles + 1].
+  const std::uint64_t global = (flags & 8) ? contractions : contractions % (h->triangle_count() + 2);
   std::vector<std::uint32_t> out(infolerp::contracted_index_bound(*h)), out_ref(out.size());
   std::vector<infolerp::index_range> ranges(clusters), ranges_ref(clusters);
   auto st = lod->frame(camera, global, out, ranges);

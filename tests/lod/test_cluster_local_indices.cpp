@@ -173,11 +173,11 @@ void check_frames(const contraction_hierarchy& h, const cluster_table& table, co
     REQUIRE(lod.ok());
     for (std::size_t k = 0; k < cams.size(); ++k) {
       const double f = std::array{0.0, 0.3, 0.65, 0.9, 0.95, 0.99, 1.0}[k % 7];
-      const auto budget = static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity()));
+      const auto budget = static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(h.triangle_count()));
       auto st = lod->frame(cams[k], budget, in, ranges);
       if (!st.ok()) FAIL(st.error().message());
       INFO("selection " << static_cast<int>(sel) << ", camera " << k << ", budget " << budget << " of "
-                        << lod->capacity());
+                        << h.triangle_count() << " triangles");
       check_localized(t, in, ranges, out, parts);
       const auto stops = lod->stop_points();
       if (sel == lod_selection::screen_error)
@@ -201,7 +201,7 @@ void check_closed_stop_points(const contraction_hierarchy& h, const local_index_
   for (int k = 0; k < draws; ++k) {
     if (k % 2 == 0) {
       for (std::uint32_t& s : stop) s = at(rng);
-      match_neighbours(h, table, stop);
+      match_neighbours(table, stop);
     } else {
       std::fill(stop.begin(), stop.end(), at(rng));
     }
@@ -299,7 +299,7 @@ TEST_CASE("16-bit local indices: bad input gets a clear status", "[lod]") {
   std::vector<std::uint32_t> in(contracted_index_bound(*h));
   std::vector<index_range> ranges(2), parts(t->part_count());
   std::vector<std::uint16_t> out(in.size());
-  REQUIRE(lod->frame(look_at({0.0, 0.5, 4.0}, {0.0, 0.0, 0.0}), lod->capacity() / 2, in, ranges).ok());
+  REQUIRE(lod->frame(look_at({0.0, 0.5, 4.0}, {0.0, 0.0, 0.0}), h->triangle_count() / 2, in, ranges).ok());
   REQUIRE(localize_indices(*t, in, ranges, out, parts).ok());
 
   std::vector<index_range> one_range(1), few_parts(1);

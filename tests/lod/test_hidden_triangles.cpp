@@ -67,9 +67,10 @@ struct lod_of {
 
 // For each camera and budget: the culled frame draws fewer triangles than its cut (when
 // `culls`), and the same first hit at every pixel of a 96 x 96 image.
-void check_same_picture(const indexed_mesh& m, const lod_of& s, std::span<const lod_camera> cams, bool culls) {
+void check_same_picture(const indexed_mesh& m, const lod_of& s, std::span<const lod_camera> cams, bool culls,
+                        const lod_options& opt = {}) {
   const support::embree_device device;
-  auto lod = view_dependent_lod::create(s.h, s.table);
+  auto lod = view_dependent_lod::create(s.h, s.table, opt);
   REQUIRE(lod.ok());
   std::vector<std::uint32_t> out(contracted_index_bound(s.h)), cut_out(out.size());
   std::vector<index_range> ranges(s.h.cluster_count);
@@ -77,8 +78,8 @@ void check_same_picture(const indexed_mesh& m, const lod_of& s, std::span<const 
   std::size_t pixels_hit = 0;
   for (std::size_t k = 0; k < cams.size(); ++k)
     for (const double f : {0.0, 0.5, 0.9}) {
-      INFO("camera " << k << ", budget " << f << " of the contractions");
-      auto st = lod->frame(cams[k], static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity())), out, ranges);
+      INFO("camera " << k << ", budget " << 1.0 - f << " of the triangles");
+      auto st = lod->frame(cams[k], static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(s.h.triangle_count())), out, ranges);
       if (!st.ok()) FAIL(st.error().message());
       auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, ranges);
       REQUIRE(cut.ok());
@@ -140,7 +141,7 @@ TEST_CASE("culling: open meshes seen from their back keep every face the camera 
     std::vector<std::uint32_t> out(contracted_index_bound(s.h)), cut_out(out.size());
     std::vector<index_range> ranges(s.h.cluster_count);
     contraction_workspace w = make_contraction_workspace(s.h);
-    auto st = lod->frame(look_at({0.0, 0.0, -4.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}), lod->capacity() / 2, out, ranges);
+    auto st = lod->frame(look_at({0.0, 0.0, -4.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}), s.h.triangle_count() / 2, out, ranges);
     REQUIRE(st.ok());
     auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, ranges);
     REQUIRE(cut.ok());
@@ -202,7 +203,7 @@ TEST_CASE("culling: keep_hidden and two-sided clusters draw the whole cut", "[lo
   for (const lod_options& opt : {lod_options{.view = {}, .keep_hidden = true}, lod_options{.view = {}, .two_sided = every}}) {
     auto lod = view_dependent_lod::create(s.h, s.table, opt);
     REQUIRE(lod.ok());
-    auto st = lod->frame(cam, lod->capacity() / 2, out, ranges);
+    auto st = lod->frame(cam, s.h.triangle_count() / 2, out, ranges);
     REQUIRE(st.ok());
     auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, ranges);
     REQUIRE(cut.ok());
@@ -302,7 +303,7 @@ TEST_CASE("culling: frame() draws exactly the cut's triangles that hidden_triang
   for (std::size_t k = 0; k < cams.size(); ++k)
     for (const double f : {0.0, 0.5, 0.9}) {
       INFO("camera " << k << ", budget " << f);
-      auto st = lod->frame(cams[k], static_cast<std::uint64_t>(f * static_cast<double>(lod->capacity())), out, ranges);
+      auto st = lod->frame(cams[k], static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(s.h.triangle_count())), out, ranges);
       REQUIRE(st.ok());
       auto cut = contract_indices(s.h, lod->stop_points(), w, cut_out, cut_ranges);
       REQUIRE(cut.ok());
@@ -333,4 +334,58 @@ TEST_CASE("culling: frame() draws exactly the cut's triangles that hidden_triang
       CHECK(st->indices == expected.size());
       CHECK(std::equal(expected.begin(), expected.end(), out.begin()));
     }
+}
+
+TEST_CASE("culling: a camera inside a closed part, and two-sided clusters, give the same picture as the cut", "[lod]") {
+  const indexed_mesh m = support::make_torus(48, 24, 1.0f, 0.35f);
+  const lod_of s(m, 6);
+  // Inside the tube, looking along it and across it: the back faces around the eye are seen.
+  const std::vector<lod_camera> inside{look_at({1.0, 0.0, 0.05}, {0.0, 1.0, 0.0}), look_at({0.0, -1.05, 0.0}, {1.0, -1.0, 0.2}),
+                                       look_at({-0.9, 0.1, -0.1}, {-1.5, 0.0, 0.3})};
+  check_same_picture(m, s, inside, false);
+  // Two-sided clusters (0 and 3) are never back-face culled; the others are, seen from outside.
+  const std::array<std::uint32_t, 2> two{0, 3};
+  const std::vector<lod_camera> outside{look_at({0.5, -3.0, 1.5}, {0.0, 0.0, 0.0}), look_at({2.5, 1.0, -0.5}, {0.0, 0.0, 0.0}),
+                                        look_at({1.0, 0.0, 0.05}, {0.0, 1.0, 0.0})};
+  check_same_picture(m, s, outside, false, {.view = {}, .two_sided = two});
+}
+
+TEST_CASE("culling: the eye-inside test counts a ray through a shared edge or vertex of a closed grid once", "[lod]") {
+  // A closed, welded box of 8 x 8 cells per face on [-1, 1]^3 (grid coordinates exact in float).
+  indexed_mesh box = support::make_box({-1, -1, -1}, {1, 1, 1});
+  for (int i = 0; i < 3; ++i) box = support::subdivide_midpoint(box);
+  std::vector<std::uint32_t> remap;
+  box = support::weld_positions(box, remap);
+  const std::vector<std::uint8_t> closed = closed_part_triangles(
+      std::span<const std::uint32_t>(&box.triangles[0].x, 3 * box.triangle_count()), box.positions);
+  REQUIRE(std::count(closed.begin(), closed.end(), 1) == static_cast<long>(box.triangle_count()));
+  // The fixed ray of eye_ray_crossing leaves the box through x = 1, y = 1 or z = 1; put the eye on
+  // that ray behind every grid vertex and edge midpoint of those faces, inside (winding 1) and
+  // outside (winding 0) the box.
+  const glm::dvec3 d(0.7296190, 0.3022190, 0.5341045);
+  std::size_t cases = 0, wrong = 0;
+  for (const glm::vec3& p : box.positions) {
+    if (!(p.x == 1.0f || p.y == 1.0f || p.z == 1.0f)) continue;
+    for (const glm::vec3& q : box.positions) {
+      const glm::vec3 mid = 0.5f * (p + q);
+      const bool vertex = p == q;
+      if (!vertex && glm::length(p - q) > 0.2501f) continue;  // grid neighbours: 0.25 apart
+      const glm::dvec3 target(vertex ? p : mid);
+      for (const double t : {0.01, 0.125, 0.3, 4.0}) {
+        const glm::dvec3 eye = target - t * d;
+        const bool inside = std::abs(eye.x) < 1.0 && std::abs(eye.y) < 1.0 && std::abs(eye.z) < 1.0;
+        const bool outside = std::abs(eye.x) > 1.0 || std::abs(eye.y) > 1.0 || std::abs(eye.z) > 1.0;
+        if (!inside && !outside) continue;
+        const view_frustum v = make_view_frustum(look_at(eye, eye + glm::dvec3(0.3, -0.2, 1.0)));
+        long winding = 0;
+        for (const glm::uvec3& f : box.triangles)
+          winding += eye_ray_crossing(v, box.positions[f.x], box.positions[f.y], box.positions[f.z]);
+        wrong += winding != (inside ? 1 : 0);
+        ++cases;
+      }
+    }
+  }
+  INFO(wrong << " wrong windings of " << cases);
+  CHECK(cases > 1000);
+  CHECK(wrong == 0);
 }

@@ -177,7 +177,7 @@ outcome run_hierarchy(const simplification_options& o) {
 }
 
 // A frame of the per-view LOD with lambda_perc, grain, a camera at `eye` looking at the origin and
-// global contractions (scaled by the capacity when `fraction`), compared with the same frame at
+// a budget of `global` triangles (half the mesh's when `fraction`), compared with the same frame at
 // the default grain.
 outcome run_lod(double lambda_perc, std::size_t grain, glm::dvec3 eye, double global, bool fraction) {
   const lod_camera camera{.position = eye, .forward = -eye, .width = 64, .height = 64};
@@ -195,7 +195,7 @@ outcome run_lod(double lambda_perc, std::size_t grain, glm::dvec3 eye, double gl
   auto lod = view_dependent_lod::create(*h, *table, opt);
   if (!lod) return {lod.error()};
   REQUIRE(ref.ok());
-  const std::uint64_t r = fraction ? static_cast<std::uint64_t>(0.5 * static_cast<double>(lod->capacity()))
+  const std::uint64_t r = fraction ? static_cast<std::uint64_t>(0.5 * static_cast<double>(h->triangle_count()))
                                    : as_count<std::uint64_t>(global);
   std::vector<std::uint32_t> out(contracted_index_bound(*h)), out_ref(out.size());
   std::vector<index_range> ranges(2), ranges_ref(2);
@@ -437,7 +437,7 @@ std::vector<option_row> lod_rows() {
        [cam](double x) { return run_lod(0.02, as_count<std::size_t>(x), cam, 0.0, true); }},
       {"view_dependent_lod::frame", "camera", true, 0, {},
        [](double x) { return run_lod(0.02, 4096, glm::dvec3(x, -2.0, 4.0), 0.0, true); }},
-      {"view_dependent_lod::frame", "contractions", false, u64_max, {},
+      {"view_dependent_lod::frame", "triangles", false, u64_max, {},
        [cam](double x) { return run_lod(0.02, 4096, cam, x, false); }},
   };
 }

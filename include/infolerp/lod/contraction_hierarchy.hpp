@@ -10,8 +10,8 @@
 // decides the order. Order: global by (cost, u, v), one heap entry per vertex (its cheapest
 // allowed contraction, updated in place); refused: non-manifold or duplicate results (link
 // condition), a normal turning past acos(min_normal_cos), a boundary vertex leaving its boundary.
-// Floor: a weight below weight_floor × the mean weight counts as that (all weights 1 when the
-// mean is 0), so that a region of zero saliency (a floor, a wall) keeps its feature and boundary
+// Weights count relative to the largest (so their scale does not matter); floor: a weight below
+// weight_floor × the mean weight counts as that (all weights 1 when the mean is 0), so that a region of zero saliency (a floor, a wall) keeps its feature and boundary
 // planes instead of collapsing at no cost.
 // Cluster-local phase (cluster_local_first, for the paper's eq. 9 selection): contractions whose
 // vertices and 1-rings lie in one cluster run first, so clusters simplify independently and
@@ -357,10 +357,15 @@ result<contraction_hierarchy> make_contraction_hierarchy(const M& m, std::span<c
   if (nt >= (std::size_t{1} << 32) / 3 || nv >= invalid_id)
     return make_error(errc::unsupported, nt, "mesh has ", nv, " vertices and ", nt, " triangles; at most 4294967294 and 1431655764 are supported");
 
-  double mean_weight = 0.0;  // sum of weight / count, overflow-free for finite weights
-  for (std::size_t k = 0; k < weights.size(); ++k) mean_weight += weights[k] / static_cast<double>(weights.size());
-  const double floor_weight = mean_weight > 0.0 ? opt.weight_floor * mean_weight : 1.0;
-  const auto weight = [&](std::size_t k) { return mean_weight > 0.0 ? std::max(weights[k], floor_weight) : 1.0; };
+  // Relative to the largest weight (exact: equal weights of any finite scale are all 1, so the
+  // order and the costs do not depend on the weights' scale), floored at weight_floor × the mean
+  // (see the top of the file).
+  const double top = weights.empty() ? 0.0 : *std::max_element(weights.begin(), weights.end());
+  double mean_weight = 0.0;  // of the weights over the largest, in [0, 1]
+  for (std::size_t k = 0; k < weights.size(); ++k) mean_weight += weights[k] / top / static_cast<double>(weights.size());
+  const auto weight = [&](std::size_t k) {
+    return mean_weight > 0.0 ? std::max(weights[k] / top, opt.weight_floor * mean_weight) : 1.0;
+  };
   detail::collapse_mesh cm;
   cm.vx.resize(nv);
   for (std::size_t v = 0; v < nv; ++v) cm.vx[v].pos = mesh_position(m, v);

@@ -26,6 +26,12 @@
 
 namespace infolerp {
 
+// Per-triangle flags of the culling spans (one_sided): a closed_face is back-face culled and
+// counts in the eye-inside test; a two_sided_face (a closed part's triangle in a cluster the
+// caller marks two-sided) is never culled but still counts, so that its part stays closed for
+// the test; 0 (open, inconsistent or inside-out) does neither.
+inline constexpr std::uint8_t closed_face = 1, two_sided_face = 2;
+
 // 1 per triangle of indices (3 per triangle) on a closed part (see above), else 0; a triangle
 // with a repeated index is 0 and holds none of its edges. Preconditions: indices < positions.size().
 // O(T log T), allocation O(T).
@@ -184,21 +190,33 @@ inline bool box_inside_frustum(const view_frustum& v, const glm::dvec3& lo, cons
   return true;
 }
 
-// The signed crossing of a fixed ray from the eye (a direction of irrational slopes, so that
-// it meets no edge of a mesh built on a grid or a symmetric shape) with triangle (a, b, c): +1
-// leaving through its front (counter-clockwise normal along the ray), −1 entering, 0 missing it.
-// Summed over a closed part, 0 when the eye is outside it. O(1) (Möller–Trumbore).
+// The signed crossing of a fixed ray from the eye (a direction of irrational slopes) with
+// triangle (a, b, c): +1 leaving through its front (counter-clockwise normal along the ray), −1
+// entering, 0 missing it. Summed over a closed part, 0 when the eye is outside it, also when the
+// ray passes exactly through a shared edge or vertex: the corners are projected on the plane
+// across the ray (the same corner, the same 2D point in every triangle), each edge's side of the
+// ray is the sign of a 2D cross product that two triangles sharing the edge compute as exact
+// negatives, and a ray exactly on an edge's line belongs to one side by the edge's direction (a
+// fill rule), so every crossing counts once. O(1).
 inline int eye_ray_crossing(const view_frustum& v, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   const glm::dvec3 d(0.7296190, 0.3022190, 0.5341045);  // ∝ (1, √2 − 1, √3 − 1), rounded
+  const glm::dvec3 e1 = glm::normalize(glm::dvec3(d.y, -d.x, 0.0));  // unit, ⊥ d
+  const glm::dvec3 e2 = glm::cross(d, e1);             // e1 × e2 ∥ d
   const glm::dvec3 pa = glm::dvec3(a) - v.eye, pb = glm::dvec3(b) - v.eye, pc = glm::dvec3(c) - v.eye;
   if (glm::dot(pa, d) < 0.0 && glm::dot(pb, d) < 0.0 && glm::dot(pc, d) < 0.0) return 0;  // behind the eye
-  const glm::dvec3 e1 = pb - pa, e2 = pc - pa, p = glm::cross(d, e2);
-  const double det = glm::dot(e1, p);
-  if (det == 0.0) return 0;
-  const glm::dvec3 s = -pa, q = glm::cross(s, e1);
-  const double u = glm::dot(s, p) / det, w = glm::dot(d, q) / det;
-  if (!(u >= 0.0 && w >= 0.0 && u + w <= 1.0) || !(glm::dot(e2, q) / det > 0.0)) return 0;
-  return glm::dot(glm::cross(e1, e2), d) > 0.0 ? 1 : -1;
+  const double ax = glm::dot(pa, e1), ay = glm::dot(pa, e2), bx = glm::dot(pb, e1), by = glm::dot(pb, e2);
+  const double cx = glm::dot(pc, e1), cy = glm::dot(pc, e2);
+  // Whether the ray (the 2D origin) lies left of edge p → q, ties by the edge's direction.
+  const auto left = [](double px, double py, double qx, double qy) {
+    const double e = px * qy - py * qx;
+    return e > 0.0 || (e == 0.0 && (qy - py > 0.0 || (qy == py && qx - px < 0.0)));
+  };
+  const bool l0 = left(ax, ay, bx, by), l1 = left(bx, by, cx, cy), l2 = left(cx, cy, ax, ay);
+  if (l0 != l1 || l1 != l2) return 0;
+  const glm::dvec3 n = glm::cross(pb - pa, pc - pa);
+  const double nd = glm::dot(n, d);
+  if (nd == 0.0 || !(glm::dot(n, pa) / nd > 0.0)) return 0;  // edge-on, or the plane behind the eye
+  return l0 ? 1 : -1;
 }
 
 // A few triangles of each cluster, to estimate the share a camera sees (visible_shares).
@@ -210,7 +228,8 @@ struct visibility_samples {
 };
 
 // Up to per_cluster triangles of each cluster of h (evenly spaced in its triangle range), and the
-// one-sided triangles of the coarsest cut; one_sided: closed_part_triangles of h.indices (two-sided clusters cleared by the caller).
+// closed triangles of the coarsest cut; one_sided: closed_part_triangles of h.indices, with
+// two_sided_face on two-sided clusters (samples there count as two-sided).
 // O(C · per_cluster + T + contractions), allocation: the result and O(V).
 inline visibility_samples make_visibility_samples(const contraction_hierarchy& h, std::span<const std::uint8_t> one_sided,
                                                   std::uint32_t per_cluster = 128) {
@@ -221,7 +240,7 @@ inline visibility_samples make_visibility_samples(const contraction_hierarchy& h
     for (std::uint32_t i = 0; i < k; ++i) {
       const std::size_t t = b + static_cast<std::size_t>((2 * std::uint64_t{i} + 1) * n / (2 * std::uint64_t{k}));
       for (std::size_t j = 0; j < 3; ++j) s.corners.push_back(h.positions[h.indices[3 * t + j]]);
-      s.one_sided.push_back(one_sided[t]);
+      s.one_sided.push_back(one_sided[t] == closed_face);
     }
     s.offsets.push_back(static_cast<std::uint32_t>(s.one_sided.size()));
   }
@@ -245,11 +264,12 @@ inline bool eye_outside_coarsest(const visibility_samples& s, const view_frustum
   return winding == 0;
 }
 
-// Per cluster, the share of its samples the camera may see (1 for a cluster without samples);
-// back_faces_hidden false: back faces count as seen. O(samples), no allocation.
+// Per cluster listed in `active` (the others untouched), the share of its samples the camera may
+// see (1 for a cluster without samples); back_faces_hidden false: back faces count as seen.
+// O(active + their samples), no allocation.
 inline void visible_shares(const visibility_samples& s, const view_frustum& v, bool back_faces_hidden,
-                           std::span<double> share) {
-  for (std::size_t c = 0; c + 1 < s.offsets.size(); ++c) {
+                           std::span<const std::uint32_t> active, std::span<double> share) {
+  for (const std::uint32_t c : active) {
     const std::uint32_t b = s.offsets[c], e = s.offsets[c + 1];
     std::uint32_t seen = 0;
     for (std::uint32_t i = b; i < e; ++i)

@@ -3,8 +3,8 @@
 // paper's eqs. 5–9 are the other option, cluster_importance.hpp). Every cluster applies the
 // owned contractions whose error, seen from the camera, stays under one threshold τ shared by
 // all clusters; τ is chosen so that, after neighbour matching closes the stop points over the
-// recorded dependencies (view_selection.hpp: no cracks), the clusters apply at most the frame's
-// budget.
+// recorded dependencies (view_selection.hpp: no cracks), the frame draws at most its budget of
+// triangles.
 //
 // Seen error of contraction i owned by cluster c: √error_i · k_c, with error_i the hierarchy's
 // cost (a squared distance per unit area, saliency-weighted; contraction_hierarchy.hpp) and
@@ -25,10 +25,10 @@
 // double: 64 steps of O(C log n)), topped up from the next larger τ. A cluster with s_c = 0
 // costs nothing drawn and takes the facing weight, so that it is not simplified past its
 // neighbours only to drag them through matching. Matching only adds contractions, so the goal
-// handed to this step is bisected (at most 11 rounds: to 1/1024) to one whose matched removal
-// stays within the goal. Where matching leaves less than half the removal to the view's choice
-// (a cluster's first contractions depend on many of the others'), the frame takes the longest
-// global prefix that draws the count instead (no matching needed).
+// handed to this step is bisected (at most 12 rounds: to 1/1024) to the smallest whose matched
+// removal reaches the frame's; the cut just short of it is then raised to at least the shortest
+// global prefix that reaches it (a prefix is closed over its dependencies, and so is the
+// maximum of two closed cuts: no matching needed), so that the count is met to one contraction.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -100,10 +100,11 @@ struct view_patch {
   double cone = 0.0;       // largest angle between a normal of the region and `normal`, radians
 };
 
-// k_g (see the top of the file) of every patch into k. Preconditions: check_camera(cam)
-// passed, options in range, k.size() == patches.size(). O(patches), no allocation.
-inline void pixels_per_unit(std::span<const view_patch> patches, const lod_camera& cam, const view_weight_options& opt,
-                            std::span<double> k) {
+// k_g (see the top of the file) of the patches listed in `active` into k (others untouched).
+// Preconditions: check_camera(cam) passed, options in range, k.size() == patches.size(), active
+// entries < patches.size(). O(active), no allocation.
+inline void pixels_per_unit(std::span<const view_patch> patches, std::span<const std::uint32_t> active,
+                            const lod_camera& cam, const view_weight_options& opt, std::span<double> k) {
   const auto [f, right, up] = make_camera_basis(cam);
   const double tv = std::tan(0.5 * cam.vertical_fov);
   const double th = tv * static_cast<double>(cam.width) / static_cast<double>(cam.height);
@@ -111,7 +112,7 @@ inline void pixels_per_unit(std::span<const view_patch> patches, const lod_camer
   // Side planes through the eye: a point (x, y, z) in camera space is inside when |x| <= z·th.
   const double ch = 1.0 / std::sqrt(1.0 + th * th), cv = 1.0 / std::sqrt(1.0 + tv * tv);
   constexpr double half_pi = 1.5707963267948966;
-  for (std::size_t g = 0; g < patches.size(); ++g) {
+  for (const std::uint32_t g : active) {
     const view_patch& a = patches[g];
     const glm::dvec3 v = a.centre - cam.position;
     const double x = glm::dot(v, right), y = glm::dot(v, up), z = glm::dot(v, f), r = a.radius, d = glm::length(v);
@@ -183,10 +184,12 @@ inline std::uint64_t budget_at(const contraction_hierarchy& h, std::span<const f
 // Per-cluster budgets for the largest τ whose seen removal Σ_c share_c · removed_at(c, b_c)
 // stays within `goal` (see the top of the file), topped up from the budgets at the next larger
 // τ as far as the goal allows (none when even τ = 0 removes more). Returns the seen removal.
-// Preconditions: maxima = cluster_error_maxima(h), faces = cluster_removed_faces(h); k, share
-// and budget one per cluster, every k finite and > 0, shares in [0, 1]. O(64 · C log n), no
-// allocation.
-inline double budgets_for_removal(const contraction_hierarchy& h, std::span<const float> maxima,
+// Only the clusters in `active` (those holding triangles, neighbour_table::active) are visited;
+// the others' budgets are left as they are. Preconditions: maxima = cluster_error_maxima(h),
+// faces = cluster_removed_faces(h); k, share and budget one per cluster, every active k finite
+// and > 0, shares in [0, 1]. O(64 · active · log n), no allocation.
+inline double budgets_for_removal(const contraction_hierarchy& h, std::span<const std::uint32_t> active,
+                                  std::span<const float> maxima,
                                   std::span<const std::uint32_t> faces, std::span<const double> k,
                                   std::span<const double> share, double goal, std::span<std::uint64_t> budget) {
   auto seen = [&](std::uint32_t c, std::uint64_t b) { return share[c] * static_cast<double>(removed_at(h, faces, c, b)); };
@@ -202,7 +205,7 @@ inline double budgets_for_removal(const contraction_hierarchy& h, std::span<cons
   };
   auto sum_at = [&](double tau) {
     double s = 0.0;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, budget_at(h, maxima, c, k[c], tau));
+    for (const std::uint32_t c : active) s += seen(c, budget_at(h, maxima, c, k[c], tau));
     return s;
   };
   // Non-negative doubles order like their bit patterns: bisect over the bits, keeping
@@ -213,23 +216,23 @@ inline double budgets_for_removal(const contraction_hierarchy& h, std::span<cons
   bool below_zero = false;
   if (sum_at(inf) <= goal) lo = top;
   else if (sum_at(0.0) > goal) below_zero = true, hi = 0;
-  for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = budget_at(h, maxima, c, k[c], 0.0) | h.capacity(c) << 32;
+  for (const std::uint32_t c : active) budget[c] = budget_at(h, maxima, c, k[c], 0.0) | h.capacity(c) << 32;
   while (!below_zero && lo != top && hi - lo > 1) {
     const std::uint64_t mid = lo + (hi - lo) / 2;
     double s = 0.0;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) s += seen(c, between(c, std::bit_cast<double>(mid)));
+    for (const std::uint32_t c : active) s += seen(c, between(c, std::bit_cast<double>(mid)));
     const bool below = s <= goal;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) {  // the budget at mid bounds its side
+    for (const std::uint32_t c : active) {  // the budget at mid bounds its side
       const std::uint64_t m = between(c, std::bit_cast<double>(mid));
       budget[c] = below ? (budget[c] >> 32 << 32) | m : (budget[c] & 0xffffffffu) | m << 32;
     }
     (below ? lo : hi) = mid;
   }
   double sum = 0.0;
-  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+  for (const std::uint32_t c : active)
     sum += seen(c, budget[c] = below_zero ? 0 : budget_at(h, maxima, c, k[c], std::bit_cast<double>(lo)));
   if (lo == top) return sum;
-  for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+  for (const std::uint32_t c : active) {
     const std::uint64_t more = budget_at(h, maxima, c, k[c], std::bit_cast<double>(hi));
     if (more <= budget[c]) continue;
     if (share[c] <= 0.0) {  // costs nothing drawn
@@ -254,78 +257,91 @@ struct selection_stats {
   std::uint32_t rounds = 0;  // budget-and-matching rounds
 };
 
-// The frame's stop points (see the top of the file), matched, drawing an estimated `triangles`
-// (at least, to about 1/1024 of the triangles to remove): cluster c of T_c triangles draws
-// share_c of those it keeps. If matching leaves less than half the removal to the view's choice,
-// the longest global prefix of at most `prefix` contractions that draws as many. k and budget are
+// The frame's stop points (see the top of the file), matched, drawing an estimated at most
+// `triangles` (to about 1/1024 of the triangles to remove): cluster c of T_c triangles draws
+// share_c of those it keeps: the view's cut whose matched removal falls just short, raised to
+// the shortest global prefix that reaches the count (the coarsest cut if none does). k and budget are
 // scratch (one per cluster). Preconditions: check_camera(cam) passed, options in range, maxima
 // = cluster_error_maxima(h), faces = cluster_removed_faces(h), spans one per cluster, shares in
-// [0, 1], prefix <= h.contraction_count(), neighbours = make_neighbour_table(h).
-// O(12 · (64 · C log n + matching)), no allocation.
+// [0, 1], neighbours = make_neighbour_table(h). Only neighbours.active clusters are visited;
+// stop points of the others are 0. O(12 · (64 · A log n + matching)) for A active clusters,
+// no allocation.
 inline selection_stats select_for_view(const contraction_hierarchy& h, const neighbour_table& neighbours,
                                        std::span<const view_patch> patches,
                                        std::span<const float> maxima, std::span<const std::uint32_t> faces,
                                        const lod_camera& cam, const view_weight_options& opt,
-                                       std::span<const double> share, std::uint64_t triangles, std::uint64_t prefix,
+                                       std::span<const double> share, std::uint64_t triangles,
                                        std::span<double> k, std::span<std::uint64_t> budget,
                                        std::span<std::uint32_t> stop) {
-  pixels_per_unit(patches, cam, opt, k);
+  const std::span<const std::uint32_t> active = neighbours.active;
+  pixels_per_unit(patches, active, cam, opt, k);
   // A cluster the camera cannot see costs no triangle drawn; simplifying it past its neighbours
   // would only drag them coarser through matching, so it is weighted as if it faced the camera.
-  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+  for (const std::uint32_t c : active)
     if (share[c] == 0.0 && k[c] < std::numeric_limits<double>::max()) k[c] /= opt.hidden_weight;
   double seen_total = 0.0;
-  for (std::uint32_t c = 0; c < h.cluster_count; ++c)
+  for (const std::uint32_t c : active)
     seen_total += share[c] * static_cast<double>(h.triangle_offsets[c + 1] - h.triangle_offsets[c]);
-  const double goal = seen_total - static_cast<double>(triangles);
+  const double goal = seen_total - static_cast<double>(triangles);  // the seen removal needed
   selection_stats st;
+  st.drawn = seen_total;
+  for (const std::uint32_t c : active) stop[c] = 0, budget[c] = 0;
+  if (goal <= 0.0) return st;
   auto run = [&](double g) {
-    (void)budgets_for_removal(h, maxima, faces, k, share, g, budget);
+    (void)budgets_for_removal(h, active, maxima, faces, k, share, g, budget);
     st.budgeted = 0;
-    for (std::uint64_t b : budget) st.budgeted += b;
-    (void)stop_points_from_budgets(h, budget, stop);  // budgets never exceed capacities
-    match_neighbours(h, neighbours, stop);
+    for (const std::uint32_t c : active) st.budgeted += budget[c];
+    for (const std::uint32_t c : active)  // budgets never exceed capacities
+      stop[c] = budget[c] == 0 ? 0 : h.cluster_contractions[h.cluster_offsets[c] + budget[c] - 1] + 1;
+    match_neighbours(neighbours, stop);
     double removed = 0.0;
     st.applied = 0;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
+    for (const std::uint32_t c : active) {
       const std::uint64_t a = applied_count(h, c, stop[c]);
       st.applied += a;
       removed += share[c] * static_cast<double>(removed_at(h, faces, c, a));
     }
     st.drawn = seen_total - removed;
     ++st.rounds;
-    return removed;
+    return removed >= goal;
   };
   // Matching only adds contractions, so the goal handed to the budgets is bisected (to 1/1024)
-  // down to the largest whose matched removal stays within the goal: at least `triangles` drawn.
-  if (run(goal) > goal && goal > 0.0) {
-    double lo = 0.0, hi = goal;
-    bool at_lo = false;
+  // between the largest whose matched removal falls short of the frame's (lo) and the smallest
+  // that reaches it (hi).
+  double lo = 0.0, hi = goal;
+  bool lo_run = false;
+  if (!run(goal)) lo = goal, lo_run = true, hi = seen_total;
+  if (lo_run && !run(hi)) lo = hi;  // matching never reaches the goal: the top-up below does
+  else
     while (hi - lo > std::max(1.0, goal / 1024.0)) {
       const double mid = 0.5 * (lo + hi);
-      at_lo = run(mid) <= goal;
-      (at_lo ? lo : hi) = mid;
+      const bool enough = run(mid);
+      (enough ? hi : lo) = mid;
+      lo_run = lo_run || !enough;
     }
-    if (!at_lo) run(lo);
+  // Top-up: lo's cut (none when lo was never run) raised to at least a global prefix P, the
+  // shortest that reaches the goal. The maximum of two dependency-closed stop vectors is closed,
+  // and so is a prefix, so no matching is needed; a prefix step is one contraction, so the
+  // frame's estimate lands within a contraction of its count. budget holds lo's stop points.
+  if (lo_run) run(lo);
+  for (const std::uint32_t c : active) budget[c] = lo_run ? stop[c] : 0;
+  auto removal_at = [&](std::uint32_t p) {
+    double removed = 0.0;
+    for (const std::uint32_t c : active)
+      removed += share[c] * static_cast<double>(removed_at(h, faces, c, applied_count(h, c, std::max(static_cast<std::uint32_t>(budget[c]), p))));
+    return removed;
+  };
+  std::uint32_t lo_p = 0, hi_p = static_cast<std::uint32_t>(h.contraction_count());
+  while (lo_p < hi_p) {
+    const std::uint32_t mid = lo_p + (hi_p - lo_p) / 2;
+    if (removal_at(mid) >= goal) hi_p = mid;
+    else lo_p = mid + 1;
   }
-  if (seen_total - st.drawn < 0.5 * goal) {  // the global prefix (see the top of the file)
-    auto removal_at = [&](std::uint32_t p) {
-      double removed = 0.0;
-      for (std::uint32_t c = 0; c < h.cluster_count; ++c)
-        removed += share[c] * static_cast<double>(removed_at(h, faces, c, applied_count(h, c, p)));
-      return removed;
-    };
-    // The longest prefix, up to `prefix`, whose seen removal stays within the goal.
-    std::uint32_t lo = 0, hi = static_cast<std::uint32_t>(prefix);
-    while (lo < hi) {
-      const std::uint32_t mid = lo + (hi - lo + 1) / 2;
-      if (removal_at(mid) <= goal) lo = mid;
-      else hi = mid - 1;
-    }
-    std::fill(stop.begin(), stop.end(), lo);
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c) budget[c] = applied_count(h, c, lo);
-    st.budgeted = st.applied = lo;
-    st.drawn = seen_total - removal_at(lo);
+  st.drawn = seen_total - removal_at(lo_p);
+  st.applied = 0;
+  for (const std::uint32_t c : active) {
+    stop[c] = std::max(static_cast<std::uint32_t>(budget[c]), lo_p);
+    st.applied += budget[c] = applied_count(h, c, stop[c]);
   }
   return st;
 }

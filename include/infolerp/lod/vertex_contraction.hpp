@@ -65,6 +65,7 @@ struct contraction_workspace {
   std::vector<std::uint32_t> chunk_count;    // per chunk, this frame: indices written
   std::vector<std::int32_t> chunk_winding;   // per chunk, this frame (culling): signed crossings of a ray from the eye
   glm::dvec3 lo{0.0}, hi{-1.0};              // the box of h.positions (empty without them): of every cut
+  bool back_faces_hidden = false;            // this frame (culling): the eye outside every closed part of the cut
   // resolve_vertex_map between frames: the stop points remap holds (empty: none yet), per vertex
   // the contractions whose target it is (CSR), scratch for the contractions to redo and a stack.
   std::vector<std::uint32_t> resolved_stop, child_offsets, children, toggled, stack;
@@ -215,6 +216,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
     for (std::size_t k = 0; k < w.chunk_run.size(); ++k) winding += w.chunk_winding[k];
     back_faces_hidden = winding == 0;
   }
+  w.back_faces_hidden = back_faces_hidden;
   const bool frustum = view && !box_inside_frustum(*view, w.lo, w.hi);
   exec.parallel_for(w.chunk_run.size(), 1, [&](std::size_t b, std::size_t e) {
     triangle_block corners;  // culling: blocks of triangles, remapped and gathered, tested, then written
@@ -228,7 +230,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
         for (std::size_t t = w.chunk_begin[k]; t < end; ++t) {
           const std::uint32_t a = remap[src[3 * t]], bb = remap[src[3 * t + 1]], c = remap[src[3 * t + 2]];
           o[0] = a, o[1] = bb, o[2] = c;
-          const bool back = back_faces_hidden && one_sided[t] != 0 && facing_away(*view, pos[a], pos[bb], pos[c]);
+          const bool back = back_faces_hidden && one_sided[t] == closed_face && facing_away(*view, pos[a], pos[bb], pos[c]);
           o += ((a != bb) & (bb != c) & (a != c) & !back) ? 3 : 0;
         }
       }
@@ -240,7 +242,7 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
             const glm::vec3& p = pos[ids[3 * i + j] = remap[src[3 * t + j]]];
             corners.x[j][i] = p.x, corners.y[j][i] = p.y, corners.z[j][i] = p.z;
           }
-          corners.one_sided[i] = back_faces_hidden & (one_sided[t] != 0);
+          corners.one_sided[i] = back_faces_hidden & (one_sided[t] == closed_face);
         }
         hidden_block(*view, corners, n, hidden);
         for (std::size_t i = 0; i < n; ++i) {
@@ -282,8 +284,8 @@ result<std::size_t> contract_indices(const contraction_hierarchy& h, std::span<c
 }
 
 // The same without the triangles the camera of `view` cannot see (hidden_triangles.hpp):
-// one_sided holds closed_part_triangles(h.indices, h.positions), cleared where back faces may be
-// seen. Errors: those of contract_indices; one_sided not one per triangle or h without its
+// one_sided holds closed_part_triangles(h.indices, h.positions), with two_sided_face where back
+// faces may be seen on a closed part (hidden_triangles.hpp). Errors: those of contract_indices; one_sided not one per triangle or h without its
 // positions (bad_size). Cost: that of contract_indices plus a test per kept triangle.
 template <class E = serial_executor>
 result<std::size_t> contract_visible_indices(const contraction_hierarchy& h, std::span<const std::uint32_t> stop,

@@ -1,6 +1,6 @@
 #pragma once
 // The per-frame entry point of view-dependent multiresolution rendering (salient-clustering
-// paper §IV): camera + global contraction budget → index buffer + per-cluster ranges.
+// paper §IV): camera + a budget of triangles drawn → index buffer + per-cluster ranges.
 //
 // Selection (lod_options::selection):
 //   screen_error (default): per-cluster budgets from one projected-error threshold, the view
@@ -16,9 +16,8 @@
 // Both then contract into the caller's index buffer (vertex_contraction.hpp), by default without
 // the triangles the camera cannot see (hidden_triangles.hpp: outside the frustum, or facing away
 // on a closed part of the mesh; never where back faces may be seen). The budget counts what is
-// drawn: R_global contractions stand for the triangles their global prefix keeps, and
-// screen_error spends them on the seen part, each cluster's seen share estimated from a sample
-// of its triangles (stats: estimated and drawn). keep_hidden draws the same cut whole, for a
+// drawn: screen_error spends it on the seen part, each cluster's seen share estimated from a
+// sample of its triangles (stats: estimated against indices / 3). keep_hidden draws the same cut whole, for a
 // shadow-map pass or a ray tracer's BVH (frame() from a light's camera is the light's own LOD).
 // paper needs a hierarchy with the cluster-local phase (create() refuses one without it).
 // Each step is usable on its own; this class keeps their buffers between frames, so frame()
@@ -48,13 +47,11 @@
 namespace infolerp {
 
 struct lod_frame_stats {
-  std::size_t indices = 0;              // indices written
-  std::uint64_t triangle_budget = 0;    // triangles the global prefix of the budget keeps (what the
-                                        // frame may draw; screen_error estimates what it draws)
-  std::uint64_t estimated = 0;          // screen_error: the triangles the selection expected to draw
+  std::size_t indices = 0;              // indices written (3 per triangle drawn)
+  std::uint64_t estimated = 0;          // the triangles the selection expected to draw (from the
+                                        // seen share of each cluster's samples)
   std::uint64_t budgeted = 0;           // Σ per-cluster budgets before matching (paper: = R_global)
-  std::uint64_t applied = 0;            // contractions applied after matching (paper: >= budgeted;
-                                        // screen_error: <= the frame's budget)
+  std::uint64_t applied = 0;            // contractions applied after matching (>= budgeted)
   std::uint32_t matching_sweeps = 0;    // paper: neighbour-matching sweeps; screen_error: selection rounds
 };
 
@@ -106,49 +103,87 @@ class view_dependent_lod {
     return view_dependent_lod(h, table, opt);
   }
 
-  // Total contractions the hierarchy offers (the largest useful R_global).
-  [[nodiscard]] std::uint64_t capacity() const { return h_->contraction_count(); }
   // Per-cluster stop points and budgets (before matching) of the last frame.
   [[nodiscard]] std::span<const std::uint32_t> stop_points() const { return stop_; }
   [[nodiscard]] std::span<const std::uint64_t> budgets() const { return budget_; }
 
-  // One frame. Errors: an invalid camera (check_camera: bad_parameter, or bad_size for an empty
-  // viewport), global_contractions > capacity() (bad_parameter); out smaller than
+  // One frame drawing at most `triangles` (what engines budget: triangles drawn after culling;
+  // with keep_hidden, triangles kept, counted exactly). The selection meets the count as
+  // estimated from each cluster's sampled share in view (stats.estimated); a frame that draws
+  // more is selected again for a count scaled by asked / drawn, at most twice, so a frame
+  // exceeds its budget only where two corrections of the estimate fall short; a budget below the
+  // coarsest cut's draws the coarsest cut, one at or above the mesh's triangle count the full mesh.
+  // paper: R_global is the shortest global prefix that keeps triangles / f, f the estimated
+  // share in view of the whole mesh (eq. 9 distributes R_global). Errors: an invalid camera
+  // (check_camera: bad_parameter, or bad_size for an empty viewport); out smaller than
   // contracted_index_bound or ranges not one per cluster (bad_size).
-  // screen_error: O(12 · (64 · C log n + matching) + samples + coarsest triangles + contractions
-  // + kept triangles / threads);
-  // paper: O(C log C + matching + contractions + kept triangles / threads).
+  // screen_error: O(12 · (64 · A log n + matching) + samples + coarsest triangles + contractions
+  // + kept triangles / threads) for A clusters that hold triangles; paper: O(C log C + matching
+  // + contractions + kept triangles / threads); times 3 at most with the corrections. No allocation.
   template <class E = serial_executor>
-  result<lod_frame_stats> frame(const lod_camera& camera, std::uint64_t global_contractions,
-                                std::span<std::uint32_t> out, std::span<index_range> ranges, E&& exec = E{}) {
+  result<lod_frame_stats> frame(const lod_camera& camera, std::uint64_t triangles, std::span<std::uint32_t> out,
+                                std::span<index_range> ranges, E&& exec = E{}) {
     static_assert(check_executor<std::remove_cvref_t<E>>());
     if (status s = check_camera(camera); !s.ok()) return s;
-    if (global_contractions > capacity())
-      return make_error(errc::bad_parameter, no_element, "global budget ", global_contractions,
-                        " exceeds the hierarchy's ", capacity(), " contractions");
     lod_frame_stats st;
-    st.triangle_budget = kept_[global_contractions];
     view_frustum view = make_view_frustum(camera);
     view.closed_lo = closed_lo_, view.closed_hi = closed_hi_;
-    if (opt_.selection == lod_selection::screen_error) {
-      if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
-      else visible_shares(samples_, view, eye_outside_coarsest(samples_, view), share_);
-      const selection_stats sel = select_for_view(*h_, neighbours_, patches_, maxima_, faces_, camera, opt_.view, share_,
-                                                  st.triangle_budget, global_contractions, area_, budget_, stop_);
-      st.budgeted = sel.budgeted, st.applied = sel.applied, st.matching_sweeps = sel.rounds;
-      st.estimated = static_cast<std::uint64_t>(std::max(0.0, std::round(sel.drawn)));
-    } else {
-      if (status s = paper_stop_points(camera.position, global_contractions); !s.ok()) return s;
-      for (std::uint64_t b : budget_) st.budgeted += b;
-      st.matching_sweeps = match_neighbours(*h_, neighbours_, stop_);
-      st.applied = applied_total(*h_, stop_);
+    const std::span<const std::uint32_t> active = neighbours_.active;
+    bool back_faces_hidden = eye_outside_coarsest(samples_, view);
+    if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
+    else visible_shares(samples_, view, back_faces_hidden, active, share_);
+    // The shares are estimated from samples of the full mesh, which a coarse cut's triangles
+    // follow only roughly: a frame drawing more than asked is selected again for the count
+    // scaled by asked / drawn (at most twice), with the shares counted again if the cut showed
+    // the eye inside a closed part where the coarsest cut did not (back faces then drawn).
+    std::uint64_t target = triangles;
+    for (int attempt = 0;; ++attempt) {
+      if (attempt > 0 && !opt_.keep_hidden && back_faces_hidden != work_.back_faces_hidden)
+        visible_shares(samples_, view, back_faces_hidden = work_.back_faces_hidden, active, share_);
+      if (status s = select(camera, target, st); !s.ok()) return s;
+      auto n = opt_.keep_hidden ? contract_indices(*h_, stop_, work_, out, ranges, exec)
+                                : contract_visible_indices(*h_, stop_, work_, view, one_sided_, out, ranges, exec);
+      if (!n.ok()) return n.error();
+      st.indices = *n;
+      const std::uint64_t drawn = *n / 3;
+      if (drawn <= triangles || attempt == 2 || opt_.keep_hidden || target == 0) break;
+      const auto scaled = static_cast<std::uint64_t>(static_cast<double>(target) * static_cast<double>(triangles) /
+                                                     static_cast<double>(drawn));
+      target = std::min(scaled, target - 1);
     }
-    auto n = opt_.keep_hidden ? contract_indices(*h_, stop_, work_, out, ranges, exec)
-                              : contract_visible_indices(*h_, stop_, work_, view, one_sided_, out, ranges, exec);
-    if (!n.ok()) return n.error();
-    st.indices = *n;
     return st;
   }
+
+ private:
+  // The stop points for `triangles` drawn as estimated, into stop_ (and st's selection figures).
+  status select(const lod_camera& camera, std::uint64_t triangles, lod_frame_stats& st) {
+    const std::span<const std::uint32_t> active = neighbours_.active;
+    if (opt_.selection == lod_selection::screen_error) {
+      const selection_stats sel = select_for_view(*h_, neighbours_, patches_, maxima_, faces_, camera, opt_.view, share_,
+                                                  triangles, area_, budget_, stop_);
+      st.budgeted = sel.budgeted, st.applied = sel.applied, st.matching_sweeps = sel.rounds;
+      st.estimated = static_cast<std::uint64_t>(std::max(0.0, std::round(sel.drawn)));
+      return {};
+    }
+    double seen = 0.0;
+    for (const std::uint32_t c : active)
+      seen += share_[c] * static_cast<double>(h_->triangle_offsets[c + 1] - h_->triangle_offsets[c]);
+    const double f = h_->triangle_count() > 0 ? seen / static_cast<double>(h_->triangle_count()) : 1.0;
+    // The shortest prefix whose kept triangles, times f, are within the budget (kept_ falls).
+    const auto within = std::partition_point(kept_.begin(), kept_.end(), [&](std::uint64_t kept) {
+      return f * static_cast<double>(kept) > static_cast<double>(triangles);
+    });
+    const auto global_contractions = static_cast<std::uint64_t>(
+        std::min(within - kept_.begin(), static_cast<std::ptrdiff_t>(h_->contraction_count())));
+    if (status s = paper_stop_points(camera.position, global_contractions); !s.ok()) return s;
+    st.budgeted = 0;
+    for (std::uint64_t b : budget_) st.budgeted += b;
+    st.matching_sweeps = match_neighbours(neighbours_, stop_);
+    st.applied = applied_total(*h_, stop_);
+    st.estimated = static_cast<std::uint64_t>(std::round(f * static_cast<double>(kept_[global_contractions])));
+    return {};
+  }
+
 
  private:
   view_dependent_lod(const contraction_hierarchy& h, const cluster_table& table, const lod_options& opt)
@@ -166,7 +201,8 @@ class view_dependent_lod {
     if (!opt.keep_hidden) {
       one_sided_ = closed_part_triangles(h.indices, h.positions);
       for (std::uint32_t g : opt.two_sided)
-        std::fill(one_sided_.begin() + h.triangle_offsets[g], one_sided_.begin() + h.triangle_offsets[g + 1], 0);
+        for (std::uint32_t t = h.triangle_offsets[g]; t < h.triangle_offsets[g + 1]; ++t)
+          if (one_sided_[t]) one_sided_[t] = two_sided_face;
       samples_ = make_visibility_samples(h, one_sided_);
       closed_part_bounds(h.indices, h.positions, one_sided_, closed_lo_, closed_hi_);
     }
@@ -195,7 +231,7 @@ class view_dependent_lod {
   std::vector<double> area_, importance_, priority_, share_;  // screen_error: area_ holds k_c
   std::vector<std::uint64_t> kept_;                          // triangles the global prefix of i contractions keeps
   std::vector<std::uint32_t> faces_;                         // cluster_removed_faces
-  std::vector<std::uint8_t> one_sided_;                      // per triangle of h.indices: back faces hidden
+  std::vector<std::uint8_t> one_sided_;                      // per triangle of h.indices: closed_face, two_sided_face or 0
   visibility_samples samples_;
   glm::dvec3 closed_lo_{0.0}, closed_hi_{0.0};                // closed_part_bounds
   std::vector<view_patch> patches_;

@@ -60,29 +60,37 @@ inline std::uint64_t applied_total(const contraction_hierarchy& h, std::span<con
 
 // Per cluster c and each other cluster c' it depends on: c's cross dependencies on c' by
 // ascending order with the running maximum of `needs`, so that matching reads the raise each
-// stop point implies by one binary search instead of one step per dependency.
+// stop point implies by one binary search instead of one step per dependency. `active` lists the
+// clusters that hold triangles (ascending): the selection's per-frame loops visit those only, so
+// that a frame's cost follows them, not the cluster ids a caller allocated.
 struct neighbour_table {
   std::vector<std::uint32_t> pair_offsets;  // per cluster, pairs + 1 (CSR)
   std::vector<std::uint32_t> pair_cluster;  // per pair: c'
   std::vector<std::uint32_t> pair_begin;    // per pair, entries + 1
   std::vector<std::uint32_t> order, needs_max;
+  std::vector<std::uint32_t> active;
 };
 
-// O(cross-cluster dependencies · clusters), allocation: the result.
+// O(C + D log D) for D cross-cluster dependencies, allocation: the result.
 inline neighbour_table make_neighbour_table(const contraction_hierarchy& h) {
   neighbour_table t;
   t.pair_offsets.push_back(0);
   t.pair_begin.push_back(0);
+  std::vector<cross_dependency> mine;
   for (std::uint32_t c = 0; c < h.cluster_count; ++c) {
-    for (std::uint32_t o = 0; o < h.cluster_count; ++o) {
-      std::uint32_t m = 0;
-      const std::size_t first = t.order.size();
-      for (std::uint32_t k = h.cross_offsets[c]; k < h.cross_offsets[c + 1]; ++k)
-        if (h.cross[k].cluster == o) t.order.push_back(h.cross[k].order), t.needs_max.push_back(m = std::max(m, h.cross[k].needs));
-      if (t.order.size() == first) continue;
-      t.pair_cluster.push_back(o);
-      t.pair_begin.push_back(static_cast<std::uint32_t>(t.order.size()));
+    if (h.triangle_offsets[c + 1] > h.triangle_offsets[c]) t.active.push_back(c);
+    mine.assign(h.cross.begin() + h.cross_offsets[c], h.cross.begin() + h.cross_offsets[c + 1]);
+    std::stable_sort(mine.begin(), mine.end(), [](const cross_dependency& a, const cross_dependency& b) {
+      return a.cluster < b.cluster;  // stable: each cluster's entries keep their ascending order
+    });
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      const bool first = k == 0 || mine[k].cluster != mine[k - 1].cluster;
+      if (first && k > 0) t.pair_begin.push_back(static_cast<std::uint32_t>(t.order.size()));
+      if (first) t.pair_cluster.push_back(mine[k].cluster);
+      const std::uint32_t m = first ? mine[k].needs : std::max(t.needs_max.back(), mine[k].needs);
+      t.order.push_back(mine[k].order), t.needs_max.push_back(m);
     }
+    if (!mine.empty()) t.pair_begin.push_back(static_cast<std::uint32_t>(t.order.size()));
     t.pair_offsets.push_back(static_cast<std::uint32_t>(t.pair_cluster.size()));
   }
   return t;
@@ -91,14 +99,13 @@ inline neighbour_table make_neighbour_table(const contraction_hierarchy& h) {
 // Neighbour matching in place: every applied cross dependency of cluster c on cluster c' raises
 // the stop point of c' past the contraction it needs; sweeps until none changes. Returns the sweeps run
 // (>= 1). Preconditions: t = make_neighbour_table(h), stop one entry per cluster.
-// O(sweeps · pairs · log dependencies), no allocation.
-inline std::uint32_t match_neighbours(const contraction_hierarchy& h, const neighbour_table& t,
-                                      std::span<std::uint32_t> stop) {
+// O(sweeps · (active clusters + pairs · log dependencies)), no allocation.
+inline std::uint32_t match_neighbours(const neighbour_table& t, std::span<std::uint32_t> stop) {
   std::uint32_t sweeps = 0;
   for (bool changed = true; changed;) {
     changed = false;
     ++sweeps;
-    for (std::uint32_t c = 0; c < h.cluster_count; ++c)  // c' != c: stop[c] holds during c's pairs
+    for (std::uint32_t c : t.active)  // c' != c: stop[c] holds during c's pairs
       for (std::uint32_t p = t.pair_offsets[c]; p < t.pair_offsets[c + 1]; ++p) {
         const auto b = t.order.begin() + t.pair_begin[p], e = t.order.begin() + t.pair_begin[p + 1];
         const auto n = std::lower_bound(b, e, stop[c]) - b;  // the applied ones
