@@ -29,31 +29,46 @@
 //   The frame rows use the default hierarchy (one global order).
 //   kind=frame, mesh refined_elephant_x4 (refined_elephant subdivided once 1:4 at edge
 //   midpoints, 355,712 triangles), fraction 0.05, 0.35, 0.60 of the triangles: method update
-//   (view_dependent_lod::frame: importance, eq. 9, matching, contraction into the index buffer;
-//   serial executor; camera 2 diagonals above the box centre; global budget (1 − f)·T/2
-//   contractions), memcpy (the full-resolution index buffer), meshoptimizer (meshopt_simplify to
-//   the triangle count update produced, from scratch); minimum over --reps repetitions
-//   interleaved in one loop, each timed update and memcpy right after an untimed one (warm). Distances are left empty for frame rows. stdout also gives the
-//   update with openmp_executor{2} (checked to produce the same index buffer) and medians.
+//   (view_dependent_lod::frame at most that fraction of the triangles drawn: selection, culling,
+//   contraction into the index buffer; serial executor; camera 2 diagonals above the box
+//   centre), memcpy (the full-resolution index buffer), meshoptimizer (meshopt_simplify to the
+//   triangle count update produced, from scratch); minimum over --reps repetitions interleaved
+//   in one loop, each timed update and memcpy right after an untimed one (warm). Distances are
+//   left empty for frame rows. stdout also gives the update with openmp_executor{2} (checked to
+//   produce the same index buffer) and medians.
+//   kind=motion (a header line of its own: kind,mesh,motion,fraction,frames,
+//   update_over_memcpy_mean,update_over_memcpy_worst): frame() at 5% of refined_elephant_x4 for
+//   a camera that moves every frame (motion_rows below: repeat, orbit5, walk), each frame's
+//   update over the fastest memcpy of the full index buffer, per frame the minimum over --reps
+//   passes of the path; mean and worst frame.
 //   kind=view (a second header line gives its columns: kind,mesh,method,fraction,view,triangles,
 //   psnr_db,ssim,weighted_distance,salient_distance,seconds,psnr_self_db), per mesh, fraction and camera:
 //   cameras orbit0..7 (those of support/mesh_views.hpp, whole mesh in frame) and close0..7
 //   (between them, at 1.2 bounding radii from the box centre: the mesh overflows the frustum);
-//   methods infolerp (view_dependent_lod::frame with default options on the default hierarchy
-//   with backstop 0.005), infolerp_paper (lod_selection::paper on a cluster-local-first
-//   hierarchy) and meshoptimizer (meshopt_simplify of the whole mesh to the triangle count
-//   infolerp drew for that camera); the budget is the global prefix's contraction count for the
-//   fraction; infolerp and infolerp_paper draw what the camera sees (frame()'s default culling),
-//   meshoptimizer the whole simplified mesh. psnr_db, ssim: that camera's 256x256
+//   methods, all at the triangle count infolerp drew for that camera:
+//     infolerp          what a user gets from the default entry point: view_dependent_lod::frame
+//                       with default options (culling included) on the default hierarchy (backstop
+//                       0.005), at most the fraction's count of triangles drawn;
+//     infolerp_paper    lod_selection::paper on a cluster-local-first hierarchy, its budget
+//                       searched so that it draws at most infolerp's count;
+//     meshopt_culled    the goal's peer: a uniform meshopt_simplify LOD culled per triangle by
+//                       the same test (support/lod_peers.hpp), the largest that draws at most
+//                       infolerp's count;
+//     meshopt_meshlets  that LOD in meshlets (64 vertices / 124 triangles, cone weight 0.25),
+//                       culled per meshlet by sphere-frustum and normal cone: a mesh-shader engine;
+//     meshoptimizer     context only: meshopt_simplify of the whole mesh to infolerp's count,
+//                       drawn whole (no culling).
+//   triangles: drawn. psnr_db, ssim: that camera's 256x256
 //   reference-shader image against the full mesh's, primary hits and shading normals from the
 //   method's drawn triangles, shadow and AO rays against the full mesh for every method alike;
 //   (their back faces ignored, so that a coarse surface just inside the full one is not shadowed
 //   by it); psnr_self_db: those rays against the drawn triangles (both faces), against the full
-//   mesh's image made alike; weighted_distance and salient_distance measure the frame's whole
-//   cut (what it draws and what it culled) and, in meshoptimizer rows, meshopt_simplify to the
-//   cut's triangle count; weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
-//   over the 10% most salient vertices (d: distance to the simplified surface); seconds: one
-//   frame() or meshopt_simplify call.
+//   mesh's image made alike; weighted_distance and salient_distance measure the whole LOD (the
+//   frame's cut, drawn and culled; a peer's whole simplified mesh; meshoptimizer's mesh);
+//   weighted_distance: Σ S(v)·d(v) / Σ S over the vertices, salient_distance: the same
+//   over the 10% most salient vertices (d: distance to the simplified surface); seconds: the
+//   per-frame step (one frame() call; a peer's culling pass over its LOD; meshopt_simplify for
+//   meshoptimizer).
 // stdout: the same rows plus memory of the hierarchy in bytes per triangle and the ratios, and
 // the mean PSNR per mesh, fraction and camera set.
 #include <meshoptimizer.h>
@@ -77,6 +92,7 @@
 #include "infolerp/saliency/mesh_saliency.hpp"
 #include "infolerp/saliency/salient_clustering.hpp"
 #include "pareto.hpp"
+#include "support/lod_peers.hpp"
 #include "support/mesh_io.hpp"
 #include "support/mesh_views.hpp"
 #include "support/procedural.hpp"
@@ -204,6 +220,76 @@ void simplify_rows(std::FILE* csv, const support::embree_device& device, const s
   }
 }
 
+// kind=motion rows: frame() at 5% for a camera that moves every frame, each frame's update
+// against a memcpy of the full index buffer timed beside it. Paths: repeat (the frame rows'
+// camera, 72 frames), orbit5 (72 frames around the box centre at 2 diagonals, 5° a frame) and
+// walk (120 frames: the eye travels 1% of the diagonal a frame towards and past the mesh, the
+// view turning 1° a frame). Frame 0 of each repetition sets the state and is not timed; per
+// frame the minimum over repetitions; mean and worst over the frames.
+void motion_rows(std::FILE* csv, view_dependent_lod& lod, const indexed_mesh& m, int reps) {
+  const bounding_box box = mesh_bounds(m);
+  const glm::dvec3 c = box.center();
+  const double diag = box.diagonal(), deg = 3.141592653589793 / 180.0;
+  const std::size_t nt = m.triangle_count();
+  const auto budget = static_cast<std::uint64_t>(0.05 * static_cast<double>(nt));
+  const auto* idx = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
+  std::vector<std::uint32_t> out(3 * nt + 3), copy(3 * nt);
+  std::vector<index_range> ranges(lod.stop_points().size());
+  struct path {
+    const char* name;
+    std::vector<lod_camera> cams;
+  };
+  std::vector<path> paths(3);
+  paths[0].name = "repeat", paths[1].name = "orbit5", paths[2].name = "walk";
+  const glm::dvec3 still = c + glm::dvec3(0.0, 0.0, 2.0 * diag);
+  for (int i = 0; i < 72; ++i) {
+    paths[0].cams.push_back({still, c - still, {0.0, 1.0, 0.0}, 0.7, 1024, 1024});
+    const double a = 5.0 * deg * i;
+    const glm::dvec3 eye = c + 2.0 * diag * glm::dvec3(std::sin(a), 0.3, std::cos(a));
+    paths[1].cams.push_back({eye, c - eye, {0.0, 1.0, 0.0}, 0.7, 1024, 1024});
+  }
+  const glm::dvec3 start = c + diag * glm::dvec3(0.3, 0.1, 1.5), look = c - start;
+  for (int i = 0; i < 120; ++i) {
+    const double a = deg * i;
+    const glm::dvec3 fwd(look.x * std::cos(a) + look.z * std::sin(a), look.y, -look.x * std::sin(a) + look.z * std::cos(a));
+    paths[2].cams.push_back({start + glm::dvec3(0.0, 0.0, -0.01 * diag * i), fwd, {0.0, 1.0, 0.0}, 0.7, 1024, 1024});
+  }
+  auto median = [](std::vector<double> v) { std::sort(v.begin(), v.end()); return v[v.size() / 2]; };
+  for (const path& pth : paths) {
+    const std::size_t n = pth.cams.size();
+    std::vector<double> upd(n, 1e30), cp_all;
+    std::vector<std::vector<double>> upd_all(n);
+    for (int r = 0; r < reps; ++r)
+      for (std::size_t i = 0; i < n; ++i) {
+        auto t = clk::now();
+        auto st = lod.frame(pth.cams[i], budget, out, ranges);
+        const double u = seconds_since(t);
+        if (!st.ok()) return void(std::fprintf(stderr, "%s\n", st.error().message().c_str()));
+        std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
+        if (copy[i % 5] != idx[i % 5]) std::abort();  // keeps the copy
+        t = clk::now();
+        std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
+        cp_all.push_back(seconds_since(t));
+        if (copy[i % 7] != idx[i % 7]) std::abort();
+        if (i == 0) continue;  // sets the state
+        upd[i] = std::min(upd[i], u);
+        upd_all[i].push_back(u);
+      }
+    const double cp = *std::min_element(cp_all.begin(), cp_all.end()), cp_med = median(cp_all);
+    double mean = 0.0, worst = 0.0, mean_med = 0.0, worst_med = 0.0;
+    for (std::size_t i = 1; i < n; ++i) {
+      mean += upd[i] / cp / static_cast<double>(n - 1), worst = std::max(worst, upd[i] / cp);
+      const double um = median(upd_all[i]) / cp_med;
+      mean_med += um / static_cast<double>(n - 1), worst_med = std::max(worst_med, um);
+    }
+    for (std::FILE* o : {csv, stdout})
+      std::fprintf(o, "motion,refined_elephant_x4,%s,0.05,%zu,%.4f,%.4f\n", pth.name, n, mean, worst);
+    std::printf("# motion %s: update/memcpy mean %.2f worst %.2f (minima over %d repetitions); medians: mean %.2f worst %.2f\n",
+                pth.name, mean, worst, reps, mean_med, worst_med);
+    std::fflush(csv);
+  }
+}
+
 void frame_rows(std::FILE* csv, int reps) {
   auto base = support::load_mesh(support::cgal_mesh("refined_elephant"));
   if (!base.ok()) return void(std::fprintf(stderr, "%s\n", base.error().message().c_str()));
@@ -228,8 +314,7 @@ void frame_rows(std::FILE* csv, int reps) {
   std::vector<std::uint32_t> out(contracted_index_bound(*h)), out2(out.size()), copy(3 * nt), mo(3 * nt);
   std::vector<index_range> ranges(h->cluster_count);
   for (double f : {0.05, 0.35, 0.60}) {
-    const auto budget = std::min<std::uint64_t>(lod->capacity(),
-                                                static_cast<std::uint64_t>((1.0 - f) * static_cast<double>(nt) / 2.0));
+    const auto budget = static_cast<std::uint64_t>(f * static_cast<double>(nt));
     double upd = 1e30, upd2 = 1e30, cp = 1e30, ms = 1e30;
     std::vector<double> upd_all, cp_all;
     std::size_t tris = 0, mo_tris = 0;
@@ -245,7 +330,7 @@ void frame_rows(std::FILE* csv, int reps) {
       if (!st.ok()) return void(std::fprintf(stderr, "%s\n", st.error().message().c_str()));
       tris = st->indices / 3;
       if (r == 0)
-        std::printf("# fraction %.2f: budget %llu contractions, %llu before matching, applied %llu (%u selection rounds, %zu cross-cluster dependencies)\n",
+        std::printf("# fraction %.2f: budget %llu triangles, %llu contractions before matching, applied %llu (%u selection rounds, %zu cross-cluster dependencies)\n",
                     f, static_cast<unsigned long long>(budget), static_cast<unsigned long long>(st->budgeted),
                     static_cast<unsigned long long>(st->applied), st->matching_sweeps, h->cross.size());
       std::memcpy(copy.data(), idx, sizeof(std::uint32_t) * 3 * nt);
@@ -273,6 +358,7 @@ void frame_rows(std::FILE* csv, int reps) {
                 "/memcpy %.2f (identical index buffer)\n",
                 f, upd / cp, median(upd_all) / median(cp_all), ms / upd, upd2, upd2 / cp);
   }
+  motion_rows(csv, *lod, m, reps);
 }
 
 // Original vertex → simplified surface distances: saliency-weighted mean over all vertices and
@@ -317,6 +403,26 @@ lod_camera to_lod_camera(const support::camera& c, std::uint32_t size) {
 double g_view_fraction = 0.0;  // --fraction: only this one (0: all)
 lod_options g_lod;             // --hidden, --silhouette, --near: the view weights of the default selection
 
+// The largest budget whose frame draws at most `drawn` triangles (the paper's selection at our
+// drawn count): secant steps on the drawn share, then bisection.
+result<std::uint64_t> budget_drawing(view_dependent_lod& l, const lod_camera& cam, std::size_t nt, std::size_t drawn,
+                                      std::vector<std::uint32_t>& out, std::vector<index_range>& ranges) {
+  std::uint64_t lo = 0, hi = nt + 1, b = drawn, best = 0;
+  for (int step = 0; step < 40 && hi - lo > std::max<std::uint64_t>(1, drawn / 1000); ++step) {
+    auto st = l.frame(cam, b, out, ranges);
+    if (!st.ok()) return st.error();
+    const std::uint64_t got = st->indices / 3;
+    if (got <= drawn) lo = b, best = b;
+    else hi = b;
+    if (got == drawn || (got <= drawn && b >= nt)) break;
+    std::uint64_t next = step < 4 && got > 0 ? static_cast<std::uint64_t>(static_cast<double>(b) * static_cast<double>(drawn) / static_cast<double>(got)) : (lo + hi) / 2;
+    if (next <= lo || next >= hi) next = lo + (hi - lo) / 2;
+    if (next == lo) break;
+    b = next;
+  }
+  return best;
+}
+
 // kind=view rows (see the top of the file).
 void view_rows(std::FILE* csv, const support::embree_device& device, const std::string& name, const indexed_mesh& m) {
   prepared p;
@@ -332,6 +438,7 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
   auto lod = view_dependent_lod::create(*h, *table, g_lod);
   auto lodp = view_dependent_lod::create(*hp, *table, lod_options{.selection = lod_selection::paper, .view = {}});
   if (!lod.ok() || !lodp.ok()) return void(std::fprintf(stderr, "%s: lod failed\n", name.c_str()));
+  const support::cull_source peers = support::make_cull_source(m);
   std::vector<double> sorted = p.saliency;
   std::sort(sorted.begin(), sorted.end());
   const double salient_cut = sorted[static_cast<std::size_t>(0.9 * static_cast<double>(sorted.size()))];
@@ -349,45 +456,59 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
     full_self.push_back(std::move((*self)[0]));
   }
   std::printf("# %s view rows: hierarchy %.3f s, %u clusters\n", name.c_str(), build, p.clusters.count);
-  std::vector<std::uint32_t> out(contracted_index_bound(*h)), mo(3 * nt), cut(out.size()), cutp(contracted_index_bound(*hp)),
-      mo_cut(3 * nt);
+  std::vector<std::uint32_t> out(contracted_index_bound(*h)), cut(out.size()), outp(contracted_index_bound(*hp)),
+      cutp(outp.size()), mo(3 * nt), mo_cut(3 * nt);
   std::vector<index_range> ranges(h->cluster_count), cut_ranges(h->cluster_count);
   contraction_workspace work = make_contraction_workspace(*h), workp = make_contraction_workspace(*hp);
+  static const char* names[] = {"infolerp", "infolerp_paper", "meshopt_culled", "meshopt_meshlets", "meshoptimizer"};
+  constexpr int methods = 5;
   for (double f : {0.35, 0.10, 0.05, 0.01}) {
     if (g_view_fraction > 0.0 && std::abs(f - g_view_fraction) > 1e-9) continue;
     const auto target = static_cast<std::size_t>(std::lround(f * static_cast<double>(nt)));
-    double psnr_sum[3] = {0, 0, 0}, worst = 1e30;
+    double psnr_sum[methods] = {}, salient_sum[methods] = {}, worst_culled = 1e30, worst_meshlets = 1e30;
     for (std::size_t v = 0; v < cams.size(); ++v) {
       const lod_camera cam = to_lod_camera(cams[v], static_cast<std::uint32_t>(vopt.width));
       const std::string view = (v < 8 ? "orbit" : "close") + std::to_string(v % 8);
-      std::size_t drawn = 0, cut_tris = 0;
-      double psnr_ours = 0.0;
-      for (int method = 0; method < 3; ++method) {
-        std::span<const std::uint32_t> idx, whole;  // drawn; the whole cut (for the distances)
-        t0 = clk::now();
-        if (method < 2) {
-          view_dependent_lod& l = method == 0 ? *lod : *lodp;
-          const contraction_hierarchy& hh = method == 0 ? *h : *hp;
-          auto st = l.frame(cam, std::min<std::uint64_t>(l.capacity(), prefix_for(hh, target)), out, ranges);
+      std::size_t drawn = 0;
+      double psnr[methods] = {};
+      for (int method = 0; method < methods; ++method) {
+        std::span<const std::uint32_t> idx, whole;  // drawn; the whole LOD (for the distances)
+        double sec = 0.0;
+        if (method == 0) {  // what a user gets from the default entry point
+          t0 = clk::now();
+          auto st = lod->frame(cam, target, out, ranges);
+          sec = seconds_since(t0);
           if (!st.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), st.error().message().c_str()));
           idx = std::span<const std::uint32_t>(out.data(), st->indices);
-          std::vector<std::uint32_t>& c = method == 0 ? cut : cutp;
-          auto n = contract_indices(hh, l.stop_points(), method == 0 ? work : workp, c, cut_ranges);
+          drawn = st->indices / 3;
+          auto n = contract_indices(*h, lod->stop_points(), work, cut, cut_ranges);
           if (!n.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), n.error().message().c_str()));
-          whole = std::span<const std::uint32_t>(c.data(), *n);
-          if (method == 0) drawn = st->indices / 3, cut_tris = *n / 3;
-        } else {
+          whole = std::span<const std::uint32_t>(cut.data(), *n);
+        } else if (method == 1) {  // the paper's eqs. 5-9 at our drawn count
+          auto budget = budget_drawing(*lodp, cam, nt, drawn, outp, ranges);
+          if (!budget.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), budget.error().message().c_str()));
+          t0 = clk::now();
+          auto st = lodp->frame(cam, *budget, outp, ranges);
+          sec = seconds_since(t0);
+          if (!st.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), st.error().message().c_str()));
+          idx = std::span<const std::uint32_t>(outp.data(), st->indices);
+          auto n = contract_indices(*hp, lodp->stop_points(), workp, cutp, cut_ranges);
+          if (!n.ok()) return void(std::fprintf(stderr, "%s: %s\n", name.c_str(), n.error().message().c_str()));
+          whole = std::span<const std::uint32_t>(cutp.data(), *n);
+        } else if (method < 4) {  // a uniform LOD with the same culling, per triangle or per meshlet
+          support::peer_frame pf = method == 2 ? support::meshopt_culled(peers, cam, drawn) : support::meshopt_meshlets(peers, cam, drawn);
+          std::copy(pf.drawn.begin(), pf.drawn.end(), mo.begin());
+          std::copy(pf.lod.begin(), pf.lod.end(), mo_cut.begin());
+          idx = std::span<const std::uint32_t>(mo.data(), pf.drawn.size());
+          whole = std::span<const std::uint32_t>(mo_cut.data(), pf.lod.size());
+          sec = pf.cull_seconds;
+        } else {  // context only: the whole uniform LOD at our drawn count, nothing culled
           const auto* in = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
+          t0 = clk::now();
           const std::size_t k = meshopt_simplify(mo.data(), in, 3 * nt, &m.positions[0].x, m.vertex_count(), sizeof(glm::vec3),
                                                  3 * drawn, std::numeric_limits<float>::max(), 0, nullptr);
-          idx = std::span<const std::uint32_t>(mo.data(), k);
-        }
-        const double sec = seconds_since(t0);
-        if (method == 2) {  // the distances at our cut's triangle count
-          const auto* in = reinterpret_cast<const std::uint32_t*>(m.triangles.data());
-          const std::size_t k = meshopt_simplify(mo_cut.data(), in, 3 * nt, &m.positions[0].x, m.vertex_count(),
-                                                 sizeof(glm::vec3), 3 * cut_tris, std::numeric_limits<float>::max(), 0, nullptr);
-          whole = std::span<const std::uint32_t>(mo_cut.data(), k);
+          sec = seconds_since(t0);
+          idx = whole = std::span<const std::uint32_t>(mo.data(), k);
         }
         // The camera's picture: primary hits and normals from the drawn triangles, shadow and AO
         // rays against the full mesh (as a shadow map or a separate BVH gives an engine); and
@@ -399,21 +520,24 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
         auto sim_self = support::compare_views(*self, std::vector<support::image>{full_self[v]});
         if (!sim || !sim_self) return void(std::fprintf(stderr, "views: comparison failed\n"));
         const view_distances d = vertex_distances(m, p.saliency, salient_cut, whole);
-        psnr_sum[method] += sim->psnr;
-        if (method == 0) psnr_ours = sim->psnr;
-        if (method == 2) worst = std::min(worst, psnr_ours - sim->psnr);
-        static const char* names[] = {"infolerp", "infolerp_paper", "meshoptimizer"};
+        psnr[method] = sim->psnr;
+        psnr_sum[method] += sim->psnr, salient_sum[method] += d.salient;
         for (std::FILE* o : {csv, stdout})
           std::fprintf(o, "view,%s,%s,%.2f,%s,%zu,%.4f,%.6f,%.6g,%.6g,%.6g,%.4f\n", name.c_str(), names[method], f,
                        view.c_str(), idx.size() / 3, sim->psnr, sim->ssim, d.weighted, d.salient, sec, sim_self->psnr);
         std::fflush(csv);
       }
+      worst_culled = std::min(worst_culled, psnr[0] - psnr[2]);
+      worst_meshlets = std::min(worst_meshlets, psnr[0] - psnr[3]);
       if (v == 7 || v == 15) {
-        std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshoptimizer %.2f dB; infolerp - meshoptimizer "
-                    "mean %+.2f, worst view %+.2f dB\n",
+        std::printf("# %s %.2f %s: mean PSNR infolerp %.2f, paper %.2f, meshopt_culled %.2f, meshopt_meshlets %.2f, "
+                    "meshoptimizer (unculled) %.2f dB; infolerp - meshopt_culled mean %+.2f, worst view %+.2f dB; "
+                    "- meshopt_meshlets mean %+.2f, worst %+.2f dB; salient distance infolerp / meshopt_culled %.3f\n",
                     name.c_str(), f, v == 7 ? "orbit" : "close", psnr_sum[0] / 8, psnr_sum[1] / 8, psnr_sum[2] / 8,
-                    (psnr_sum[0] - psnr_sum[2]) / 8, worst);
-        psnr_sum[0] = psnr_sum[1] = psnr_sum[2] = 0.0, worst = 1e30;
+                    psnr_sum[3] / 8, psnr_sum[4] / 8, (psnr_sum[0] - psnr_sum[2]) / 8, worst_culled,
+                    (psnr_sum[0] - psnr_sum[3]) / 8, worst_meshlets, salient_sum[2] > 0.0 ? salient_sum[0] / salient_sum[2] : 0.0);
+        for (int k = 0; k < methods; ++k) psnr_sum[k] = salient_sum[k] = 0.0;
+        worst_culled = worst_meshlets = 1e30;
       }
     }
   }
@@ -459,6 +583,7 @@ int pareto_lod(int argc, char** argv) {
   if (views)
     std::fprintf(csv, "kind,mesh,method,fraction,view,triangles,psnr_db,ssim,weighted_distance,salient_distance,seconds,"
                  "psnr_self_db\n");
+  if (frames) std::fprintf(csv, "kind,mesh,motion,fraction,frames,update_over_memcpy_mean,update_over_memcpy_worst\n");
   std::vector<std::pair<std::string, std::string>> meshes;
   if (builtin)
     for (const char* name : {"bunny00", "armadillo", "refined_elephant"}) meshes.emplace_back(name, support::cgal_mesh(name));

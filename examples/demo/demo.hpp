@@ -69,10 +69,10 @@ struct stage_time {
 
 // One simplified mesh of the LOD stage, for the LOD table and lod.csv.
 struct lod_result {
-  std::string method;                // "full", "infolerp" (view_dependent_lod::frame), "meshoptimizer"
+  std::string method;                // "full", "infolerp" (view_dependent_lod::frame), "meshopt_culled", "meshopt_meshlets"
   double fraction = 1.0;             // of the full mesh's triangles asked for
   std::size_t triangles = 0;         // drawn
-  double seconds = 0.0;              // the frame() update or the meshopt_simplify call
+  double seconds = 0.0;              // the per-frame step: frame(), or the peer's culling pass
   double weighted_distance = 0.0;    // saliency-weighted mean distance to the full mesh
   double hausdorff = 0.0;            // Hausdorff distance to the full mesh
   double psnr = 0.0, ssim = 1.0;     // of its image against the full mesh's image of the same view

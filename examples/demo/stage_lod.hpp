@@ -4,19 +4,22 @@
 //   - the mesh (seam vertices welded) gets its saliency, 10 salient clusters, the weighting map
 //     and the contraction hierarchy (library defaults);
 //   - one view: camera 0 of support/mesh_views.hpp around the mesh; view_dependent_lod::frame
-//     from that eye with the global budget (1 − f)·T/2 contractions for f = 35% and 5%;
-//   - meshoptimizer's meshopt_simplify (no options, target error FLT_MAX) to the triangle count
-//     the frame produced, when the demo is built with meshoptimizer;
+//     from that eye drawing at most f·T triangles for f = 35% and 5%;
+//   - what an engine draws instead, when the demo is built with meshoptimizer
+//     (support/lod_peers.hpp): meshopt_culled (a uniform meshopt_simplify LOD culled per
+//     triangle by the same test) and meshopt_meshlets (that LOD in meshlets of 124 triangles
+//     culled by sphere and normal cone), each at the largest LOD that draws at most the count
+//     our frame drew;
 //   - DIR/lod.png: the reference shader's images of that view (full mesh on the left, then 35%
-//     and 5%; top row the saliency LOD, bottom row meshoptimizer's), panels of min(W, H, 384)
+//     and 5%; rows: the saliency LOD, meshopt_culled, meshopt_meshlets), panels of min(W, H, 384)
 //     pixels (at least 16), each labelled with its method, fraction, triangles and PSNR;
 //   - ctx.lod_results (the LOD table and lod.csv of the summary stage): per mesh the triangle
-//     count, the seconds of the frame update or the meshopt_simplify call, the saliency-weighted
-//     mean distance and the Hausdorff distance to the full mesh (support/surface_distance.hpp),
-//     PSNR and SSIM against the full mesh's image of the same view (not the scene reference);
-//   - frame() draws what the camera sees (its default culling); every panel's shadow and AO rays
-//     go against the full mesh; the distances measure the frame's whole cut (drawn and culled)
-//     and, for meshoptimizer, meshopt_simplify to that cut's triangle count;
+//     count drawn, the seconds of the per-frame step (frame(), or the peer's culling pass), the
+//     saliency-weighted mean distance and the Hausdorff distance to the full mesh
+//     (support/surface_distance.hpp), PSNR and SSIM against the full mesh's image of the same
+//     view (not the scene reference);
+//   - every panel's shadow and AO rays go against the full mesh; the distances measure the
+//     whole LOD (frame(): its cut, drawn and culled; a peer: its whole simplified mesh);
 //   - DIR/lod_orbit.png: six cameras around the mesh (mesh_views' circle of 6), each one's
 //     frame() at 5% with the default options; top row the triangles from that camera, bottom row
 //     the same triangles from the opposite camera (the holes are what the camera culled). Both rows are headlight-shaded with the edges
@@ -38,7 +41,7 @@
 #include <string>
 #include <vector>
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
-#include <meshoptimizer.h>
+#include "support/lod_peers.hpp"
 #endif
 #include "demo.hpp"
 #include "draw_label.hpp"
@@ -82,12 +85,11 @@ inline lod_camera lod_eye(const support::camera& c, int side) {
           static_cast<double>(c.vertical_fov_degrees) * std::numbers::pi / 180.0, pixels, pixels};
 }
 
-// frame() into p.indices for a fraction f of the T triangles: (1 − f)·T/2 contractions, each
-// removing about two triangles. Returns the status of frame() and times it.
+// frame() into p.indices drawing at most a fraction f of the T triangles. Returns the status of
+// frame() and times it.
 inline status lod_frame(view_dependent_lod& lod, const contraction_hierarchy& h, const lod_camera& eye, std::size_t nt,
                         lod_panel& p) {
-  const auto budget =
-      std::min<std::uint64_t>(lod.capacity(), static_cast<std::uint64_t>((1.0 - p.fraction) * static_cast<double>(nt) / 2.0));
+  const auto budget = static_cast<std::uint64_t>(p.fraction * static_cast<double>(nt));
   std::vector<index_range> ranges(h.cluster_count);
   p.indices.resize(contracted_index_bound(h));
   const auto t0 = std::chrono::steady_clock::now();
@@ -289,32 +291,38 @@ inline bool stage_lod(demo_context& ctx) {
   if (!detail::finish_panel(ctx, device, m, saliency, view, full, nullptr)) return false;
 
   std::vector<detail::lod_panel> panels;
+#ifdef INFOLERP_DEMO_MESHOPTIMIZER
+  const support::cull_source peers = support::make_cull_source(m);
+#endif
   for (const double f : {0.35, 0.05}) {
     detail::lod_panel ours{"infolerp", f, {}, 0.0, {}, {}, {}};
     if (auto s = detail::lod_frame(*lod, *h, detail::lod_eye(cam, side), nt, ours); !s) return report(s), false;
     if (!detail::finish_panel(ctx, device, m, saliency, view, ours, &full.img)) return false;
 #ifdef INFOLERP_DEMO_MESHOPTIMIZER
-    detail::lod_panel theirs{"meshoptimizer", f, std::vector<std::uint32_t>(3 * nt), 0.0, {}, {}, {}};
-    const auto t1 = std::chrono::steady_clock::now();
-    const std::size_t k = meshopt_simplify(theirs.indices.data(), full_idx, 3 * nt, &m.positions[0].x, m.vertex_count(),
-                                           sizeof(glm::vec3), ours.indices.size(), std::numeric_limits<float>::max(), 0, nullptr);
-    theirs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-    theirs.indices.resize(k);
-    theirs.cut.resize(3 * nt);  // the distances at the triangle count of our whole cut
-    theirs.cut.resize(meshopt_simplify(theirs.cut.data(), full_idx, 3 * nt, &m.positions[0].x, m.vertex_count(),
-                                       sizeof(glm::vec3), ours.cut.size(), std::numeric_limits<float>::max(), 0, nullptr));
-    if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
+    // What an engine draws instead: a uniform LOD with the same culling, per triangle or per
+    // meshlet, at the count our frame drew (support/lod_peers.hpp).
+    for (const bool meshlets : {false, true}) {
+      const std::size_t drawn = ours.indices.size() / 3;
+      support::peer_frame pf = meshlets ? support::meshopt_meshlets(peers, detail::lod_eye(cam, side), drawn)
+                                        : support::meshopt_culled(peers, detail::lod_eye(cam, side), drawn);
+      detail::lod_panel theirs{meshlets ? "meshopt_meshlets" : "meshopt_culled", f, std::move(pf.drawn), pf.cull_seconds,
+                               {}, {}, std::move(pf.lod)};
+      if (!detail::finish_panel(ctx, device, m, saliency, view, theirs, &full.img)) return false;
+      panels.push_back(std::move(theirs));
+    }
+    panels.insert(panels.end() - 2, std::move(ours));
 #else
-    detail::lod_panel theirs;
-#endif
     panels.push_back(std::move(ours));
-    panels.push_back(std::move(theirs));
+    panels.resize(panels.size() + 2);
+#endif
   }
-  for (auto* p : {&full, &panels[0], &panels[1], &panels[2], &panels[3]})
-    if (!p->img.pixels.empty()) draw_label(p->img, 0, 0, p->label, label_scale(side));
-  // Grid: full | 35% | 5%, saliency LOD on top, meshoptimizer below.
+  for (auto& p : panels)
+    if (!p.img.pixels.empty()) draw_label(p.img, 0, 0, p.label, label_scale(side));
+  draw_label(full.img, 0, 0, full.label, label_scale(side));
+  // Grid: full | 35% | 5%; rows: the saliency LOD, meshopt_culled, meshopt_meshlets.
   const auto cell = [&](std::size_t k) { return panels[k].indices.empty() ? nullptr : &panels[k].img; };
-  const support::image grid = detail::lod_grid({&full.img, cell(0), cell(2), &full.img, cell(1), cell(3)}, 3, side);
+  const support::image grid =
+      detail::lod_grid({&full.img, cell(0), cell(3), &full.img, cell(1), cell(4), &full.img, cell(2), cell(5)}, 3, side);
   return save_png(ctx, grid, "lod.png") && detail::lod_orbit(ctx, device, *lod, *h, m, side);
 }
 
