@@ -1,6 +1,7 @@
 #pragma once
 // How infolerp casts rays: through the user's tracer. The library never includes a ray tracer;
-// tests, benchmarks and examples plug in Embree 3 (tests/support/embree_tracer.hpp).
+// examples/embree_tracer.hpp is a small Embree 3 adaptor to copy (tests and benchmarks use the
+// fuller tests/support/embree_tracer.hpp).
 //
 // Required (const, thread-safe for concurrent calls):
 //   bool occluded(const ray&)        true when anything lies on the ray within [tnear, tfar]
