@@ -119,6 +119,29 @@ TEST_CASE("a cube splits into its 6 faces under orientation", "[cluster]") {
   REQUIRE(r->channels[0].all_alike_sets == 0);
 }
 
+TEST_CASE("channels that trace nothing run with no_tracer", "[cluster]") {
+  // The cube's faces from their normals (the reference), with no tracer in the call.
+  const auto cube = support::make_box({-1, -1, -1}, {1, 1, 1});
+  auto r = cluster_mesh(cube, no_tracer{}, serial, orientation_channel{.threshold = 0.05});
+  REQUIRE(r.ok());
+  check_invariants(cube, *r);
+  REQUIRE(r->cluster_count == 6);
+  const auto n = face_normals(cube);
+  for (std::size_t a = 0; a < n.size(); ++a)
+    for (std::size_t b = 0; b < n.size(); ++b) REQUIRE((r->cluster_of[a] == r->cluster_of[b]) == (n[a] == n[b]));
+  // Orientation then stretch on a textured mesh: the tracer, never called, changes nothing.
+  const auto sphere = support::make_uv_sphere(16, 12);
+  const test::brute_tracer tracer(sphere);
+  const orientation_channel o{.threshold = 0.02};
+  const stretch_channel st{.threshold = 0.1};
+  auto with = cluster_mesh(sphere, tracer, serial, o, st);
+  auto without = cluster_mesh(sphere, no_tracer{}, serial, cluster_options{}, o, st);
+  REQUIRE(with.ok());
+  REQUIRE(without.ok());
+  REQUIRE(without->channels[1].skipped == nullptr);
+  REQUIRE(without->cluster_of == with->cluster_of);
+}
+
 TEST_CASE("a planar patch is one cluster with no work done", "[cluster]") {
   const auto plane = support::make_plane(10, 10, 1.0f);
   const test::brute_tracer tracer(plane);

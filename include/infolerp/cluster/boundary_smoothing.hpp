@@ -50,7 +50,7 @@ inline bool shared_edge(glm::uvec3 p, glm::uvec3 q, std::uint32_t& a, std::uint3
 }
 // Sorts keys ascending: an LSD radix sort over the bytes in which the keys differ (edge keys
 // of a mesh under 2^16 vertices differ in 4 of 8), std::sort below 256 keys. Boundaries and
-// bands run to thousands of edges, where std::sort took ~6% of refined_elephant's clustering.
+// bands run to thousands of edges, where std::sort was a visible share of the clustering.
 // O(n·bytes), scratch resized to n (reused by the caller).
 inline void sort_keys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch) {
   const std::size_t n = keys.size();

@@ -10,6 +10,12 @@
 //       infolerp::orientation_channel{.threshold = 0.02f},
 //       infolerp::stretch_channel{.threshold = 0.10f});   // skipped (and reported) without UVs
 //
+// Channels that trace nothing (orientation, stretch, a visibility channel passed prepared) need
+// no tracer: pass infolerp::no_tracer{} in its place.
+//
+//   auto ids = infolerp::cluster_mesh(mesh, infolerp::no_tracer{}, exec,
+//       infolerp::orientation_channel{.threshold = 0.02f});
+//
 // Output: a dense cluster id per triangle (0..C−1, numbered by smallest triangle), every
 // cluster edge-connected, identical for any executor and thread count. Th = 0 for any channel
 // gives one cluster per triangle, Th = 1 for every channel one cluster per connected component.
@@ -67,6 +73,10 @@ struct mesh_clustering {
   std::vector<channel_report> channels;   // one per channel, in order (the last keyframe's for cluster_keyframes)
 };
 
+// Stands in for the tracer when no channel traces rays. A visibility_channel (which prepares by
+// tracing) with no_tracer is refused at compile time with a message saying so.
+struct no_tracer {};
+
 // A channel Algorithm 1 accepts: a prepared channel, or one with prepare(mesh, topo, tracer, exec).
 template <class C, class M, class T, class E>
 concept clustering_channel =
@@ -76,6 +86,13 @@ concept clustering_channel =
     };
 
 namespace detail {
+
+// check_tracer, with no_tracer accepted. Compile time only.
+template <class T>
+constexpr bool check_cluster_tracer() {
+  if constexpr (std::is_same_v<T, no_tracer>) return true;
+  else return check_tracer<T>();
+}
 
 // Seconds on the steady clock since `since`, which is then moved to now.
 inline double lap(std::chrono::steady_clock::time_point& since) {
@@ -195,20 +212,28 @@ template <class M, class T, class E, class... C>
 result<mesh_clustering> cluster_mesh(const M& m, const T& tracer, E&& exec, const cluster_options& opts,
                                      const C&... channels) {
   static_assert(check_mesh<M>());
-  static_assert(check_tracer<T>());
+  static_assert(detail::check_cluster_tracer<T>());
   static_assert(check_executor<std::remove_cvref_t<E>>());
   static_assert(sizeof...(C) >= 1, "infolerp: cluster_mesh needs at least one channel");
   static_assert((clustering_channel<C, M, T, std::remove_cvref_t<E>> && ...),
                 "infolerp: each channel needs a `threshold` and init(span<const uint32_t>) -> result<channel_state>, "
                 "or prepare(mesh, topology, tracer, executor) (see cluster/channel.hpp)");
-  if (status st = detail::check_inputs<M, E>(m, opts, channels...); !st) return st;
-  auto topo = make_topology(m);
-  if (!topo) return topo.error();
-  mesh_clustering out;
-  out.cluster_of.assign(mesh_triangle_count(m), 0);
-  out.cluster_count = 1;
-  if (status st = detail::algorithm1(m, *topo, tracer, exec, opts, out, channels...); !st) return st;
-  return out;
+  constexpr bool traces_without_tracer =
+      std::is_same_v<T, no_tracer> && (std::is_same_v<C, visibility_channel> || ...);
+  static_assert(!traces_without_tracer,
+                "infolerp: visibility_channel traces rays: pass a tracer instead of no_tracer (or the channel prepared)");
+  if constexpr (traces_without_tracer) {
+    return make_error(errc::bad_parameter, no_element, "cluster_mesh: visibility_channel without a tracer");
+  } else {
+    if (status st = detail::check_inputs<M, E>(m, opts, channels...); !st) return st;
+    auto topo = make_topology(m);
+    if (!topo) return topo.error();
+    mesh_clustering out;
+    out.cluster_of.assign(mesh_triangle_count(m), 0);
+    out.cluster_count = 1;
+    if (status st = detail::algorithm1(m, *topo, tracer, exec, opts, out, channels...); !st) return st;
+    return out;
+  }
 }
 
 // The same with default options.

@@ -63,7 +63,7 @@ inline double degener_stretch(const triangle_corners& c, glm::dvec2 uv0, glm::dv
   // Closed-form singular values of [a b; cc d].
   const double e = 0.5 * (a + d), f = 0.5 * (a - d), g = 0.5 * (cc + b), h = 0.5 * (cc - b);
   // |(u, w)|: sqrt(u² + w²) where the squares can neither overflow nor underflow (libm's
-  // hypot took ~1.5% of the three-channel clustering), hypot elsewhere.
+  // hypot is a visible share of the three-channel clustering), hypot elsewhere.
   auto norm = [](double u, double w) {
     const double big = std::max(std::abs(u), std::abs(w));
     return big < 0x1p500 && big > 0x1p-500 ? std::sqrt(u * u + w * w) : std::hypot(u, w);

@@ -18,7 +18,7 @@
 // its edge neighbours in the set with JS <= Th (most tests are decided by an upper bound on JS
 // without logarithms, see visibility_state::surely_within).
 // Rows that are bit-identical (row and p(t)) after denoising share their divergences through
-// visibility_state::representative (69k groups for 89k triangles on refined_elephant).
+// visibility_state::representative (hidden, flat and denoised regions give many such rows).
 // visibility_state::estimate (info/js_estimate.hpp, one entropy estimate per row at init) lets
 // the clustering decide nearly all its comparisons without the exact JS kernel.
 //

@@ -81,8 +81,11 @@ concept keyframed_mesh = mesh<M> && requires(const M& m, std::size_t k, std::siz
 };
 
 // Entry points take `template <class M>` (unconstrained) and start with
-// static_assert(check_mesh<M>()): a type that is not a mesh then gets one message naming what
-// it lacks, not a page of template noise. Returns true so it can sit in a static_assert.
+// static_assert(check_mesh<M>()): a type that is not a mesh then gets one message per member it
+// lacks, naming it, and nothing else. Instantiated once per type, so the messages appear once
+// however many entry points a translation unit calls; returns true (the failed member's own
+// static_assert has already stopped the build), so the caller's static_assert adds no second
+// error. Compile time only.
 template <class M>
 constexpr bool check_mesh() {
   static_assert(detail::has_vertex_count<M>,
@@ -93,30 +96,49 @@ constexpr bool check_mesh() {
                 "infolerp: mesh type needs `glm::vec3 position(size_t vertex) const` (or mesh_traits<M>::position)");
   static_assert(detail::has_triangle<M>,
                 "infolerp: mesh type needs `glm::uvec3 triangle(size_t t) const` (or mesh_traits<M>::triangle)");
-  return mesh<M>;
+  return true;
 }
 
 // Shorthands used throughout the library: O(1) forwarding to mesh_traits, no allocation.
-template <mesh M> std::size_t mesh_vertex_count(const M& m) { return mesh_traits<M>::vertex_count(m); }
-template <mesh M> std::size_t mesh_triangle_count(const M& m) { return mesh_traits<M>::triangle_count(m); }
-template <mesh M> glm::vec3 mesh_position(const M& m, std::size_t v) { return mesh_traits<M>::position(m, v); }
-template <mesh M> glm::uvec3 mesh_triangle(const M& m, std::size_t t) { return mesh_traits<M>::triangle(m, t); }
+// Unconstrained, and checked by check_mesh: on a type that is not a mesh the build stops at
+// check_mesh's message, and these compile to a placeholder value instead of adding a cascade of
+// "no matching function" errors from every body that reads the mesh.
+template <class M> std::size_t mesh_vertex_count(const M& m) {
+  static_assert(check_mesh<M>());
+  if constexpr (mesh<M>) return mesh_traits<M>::vertex_count(m);
+  else return 0;
+}
+template <class M> std::size_t mesh_triangle_count(const M& m) {
+  static_assert(check_mesh<M>());
+  if constexpr (mesh<M>) return mesh_traits<M>::triangle_count(m);
+  else return 0;
+}
+template <class M> glm::vec3 mesh_position(const M& m, std::size_t v) {
+  static_assert(check_mesh<M>());
+  if constexpr (mesh<M>) return mesh_traits<M>::position(m, v);
+  else return glm::vec3(0.0f);
+}
+template <class M> glm::uvec3 mesh_triangle(const M& m, std::size_t t) {
+  static_assert(check_mesh<M>());
+  if constexpr (mesh<M>) return mesh_traits<M>::triangle(m, t);
+  else return glm::uvec3(0u);
+}
 // True when the type offers texcoords and this instance has them.
-template <mesh M> bool mesh_has_texcoords(const M& m) {
+template <class M> bool mesh_has_texcoords(const M& m) {
   if constexpr (textured_mesh<M>) return mesh_traits<M>::has_texcoords(m);
   else return false;
 }
-template <mesh M> bool mesh_has_normals(const M& m) {
+template <class M> bool mesh_has_normals(const M& m) {
   if constexpr (mesh_with_normals<M>) return mesh_traits<M>::has_normals(m);
   else return false;
 }
-template <mesh M> std::size_t mesh_keyframe_count(const M& m) {
+template <class M> std::size_t mesh_keyframe_count(const M& m) {
   if constexpr (keyframed_mesh<M>) return mesh_traits<M>::keyframe_count(m);
   else return 0;
 }
 // Positions stored for keyframe k: keyframe_vertex_count(k) where the type offers it, else
 // vertex_count() (the documented precondition of keyframes without it).
-template <mesh M> std::size_t mesh_keyframe_vertex_count(const M& m, std::size_t k) {
+template <class M> std::size_t mesh_keyframe_vertex_count(const M& m, std::size_t k) {
   if constexpr (requires { mesh_traits<M>::keyframe_vertex_count(m, k); }) return mesh_traits<M>::keyframe_vertex_count(m, k);
   else return mesh_vertex_count(m);
 }

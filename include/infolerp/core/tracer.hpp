@@ -1,6 +1,7 @@
 #pragma once
 // How infolerp casts rays: through the user's tracer. The library never includes a ray tracer;
-// tests, benchmarks and examples plug in Embree 3 (tests/support/embree_tracer.hpp).
+// examples/embree_tracer.hpp is a small Embree 3 adaptor to copy (tests and benchmarks use the
+// fuller tests/support/embree_tracer.hpp).
 //
 // Required (const, thread-safe for concurrent calls):
 //   bool occluded(const ray&)        true when anything lies on the ray within [tnear, tfar]
@@ -60,22 +61,27 @@ concept batch_intersection_tracer = tracer<T> && requires(const T& t, std::span<
 };
 
 // For `static_assert(check_tracer<T>())` at entry points: one readable message per missing
-// member. Compile time only.
+// member, once per type, and nothing else (returns true: the member's own static_assert has
+// stopped the build, and trace_occluded / trace_intersect below add no errors of their own).
+// Compile time only.
 template <class T>
 constexpr bool check_tracer() {
   static_assert(requires(const T& t, const ray& r) { { t.occluded(r) } -> std::convertible_to<bool>; },
                 "infolerp: tracer type needs `bool occluded(const infolerp::ray&) const`");
   static_assert(requires(const T& t, const ray& r) { { t.intersect(r) } -> std::convertible_to<hit>; },
                 "infolerp: tracer type needs `infolerp::hit intersect(const infolerp::ray&) const`");
-  return tracer<T>;
+  return true;
 }
 
 // Occlusion of many rays: the tracer's batch overload when it has one, else one ray at a time.
 // Preconditions: out.size() >= rays.size(). Complexity: rays.size() tracer queries.
 // Allocation: none (the tracer's own aside). Thread-safe when the tracer's const calls are.
-template <tracer T>
+template <class T>
 void trace_occluded(const T& t, std::span<const ray> rays, std::span<std::uint8_t> out) {
-  if constexpr (batch_occlusion_tracer<T>) {
+  static_assert(check_tracer<T>());
+  if constexpr (!tracer<T>) {
+    return;  // not a tracer: check_tracer has stopped the build
+  } else if constexpr (batch_occlusion_tracer<T>) {
     t.occluded(rays, out.first(rays.size()));
   } else {
     for (std::size_t i = 0; i < rays.size(); ++i) out[i] = t.occluded(rays[i]) ? 1 : 0;
@@ -84,9 +90,12 @@ void trace_occluded(const T& t, std::span<const ray> rays, std::span<std::uint8_
 
 // Closest hits of many rays, batched when the tracer can. Preconditions: out.size() >= rays.size().
 // Complexity: rays.size() tracer queries. Allocation: none. Thread-safe when the tracer's const calls are.
-template <tracer T>
+template <class T>
 void trace_intersect(const T& t, std::span<const ray> rays, std::span<hit> out) {
-  if constexpr (batch_intersection_tracer<T>) {
+  static_assert(check_tracer<T>());
+  if constexpr (!tracer<T>) {
+    return;  // not a tracer: check_tracer has stopped the build
+  } else if constexpr (batch_intersection_tracer<T>) {
     t.intersect(rays, out.first(rays.size()));
   } else {
     for (std::size_t i = 0; i < rays.size(); ++i) out[i] = t.intersect(rays[i]);

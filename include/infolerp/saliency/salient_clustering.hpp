@@ -24,11 +24,10 @@
 //   last); growth never takes a seed's faces, so no seeded cluster ends empty.
 //   4. Repeat 2–3 until the seeds repeat a previous iteration's (converged, or a cycle: the
 //      paper accepts any point on a cycle; we stop at the repeat) or max_iterations.
-//      How many rounds that takes is chance, not mesh size (12–25 on bunny00 split to 300k and
-//      1.2M triangles, user seeds 1–5). max_iterations trades time for settling: each round
-//      costs O(T log T), and a capped call ends on the last round's clusters (converged = false)
-//      (the clusters' quality at a stopping round was measured to vary as much as the round
-//      count: benchmarks/NOTES.md, salient clustering at 300k and 1.2M triangles).
+//      How many rounds that takes is chance (the seeds), not mesh size. max_iterations trades
+//      time for settling: each round costs O(T log T), and a capped call ends on the last
+//      round's clusters (converged = false), whose quality varies from round to round as much
+//      as the round count does (benchmarks/NOTES.md, salient clustering at 300k and 1.2M).
 // Face saliency S_f is the mean of its corners' vertex saliencies; x_f the centroid; n_f the
 // unit normal. Ties in every queue break by (cost, cluster, face), so the result is a function
 // of the mesh, the saliency and the seed only. Faces that no seed can reach (another connected

@@ -183,9 +183,9 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   // (the cell of its cell at σ_{u−1}).
   std::vector<proxy_cells> proxies(L);
   std::vector<std::vector<std::uint32_t>> cell_of(L, std::vector<std::uint32_t>(P));
-  // Groupings of 2^19 points or more (at 1.2M triangles the finest alone) run through exec; the
-  // smaller ones serially: their ~10 parallel phases cost more in barriers than they gain when
-  // other processes share the cores (at 185k and 337k points 2-3x the serial time at a load of 5).
+  // Groupings of 2^19 points or more run through exec; the smaller ones serially: their ~10
+  // parallel phases cost more in barriers than they gain when other processes share the cores
+  // (benchmarks/NOTES.md, saliency proxy).
   serial_executor serial;
   for (std::size_t u = 0; u < L; ++u) {
     const vertex_points& grouped = u == 0 ? pts : proxies[u - 1].points;
@@ -204,8 +204,7 @@ std::vector<double> proxy_gaussian_averages(E& exec, const vertex_points& pts, c
   auto kernel = [&](auto& ex, std::size_t u) {
     const vertex_points& q = proxies[u].points;
     // Columns one ball wide: a proxy has about (4·cells_per_sigma)² neighbours in a ball, too
-    // few for the exact kernel's narrower columns to pay for their overhead (3x slower at 2
-    // cells per σ).
+    // few for the exact kernel's narrower columns to pay for their overhead.
     const std::vector<double> a = exact_gaussian_averages(ex, q, {sigma[u]}, grain, 1.0);
     at_proxy[u].resize(a.size());
     for (std::size_t i = 0; i < a.size(); ++i) at_proxy[u][i] = {q.x[i], q.y[i], q.z[i], a[i]};
