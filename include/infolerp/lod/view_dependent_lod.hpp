@@ -108,18 +108,19 @@ class view_dependent_lod {
   [[nodiscard]] std::span<const std::uint64_t> budgets() const { return budget_; }
 
   // One frame drawing at most `triangles` (what engines budget: triangles drawn after culling;
-  // with keep_hidden, triangles kept, counted exactly). The selection meets the count as
-  // estimated from each cluster's sampled share in view (stats.estimated); a frame that draws
-  // more is selected again for a count scaled by asked / drawn, at most twice, so a frame
-  // exceeds its budget only where two corrections of the estimate fall short; a budget below the
-  // coarsest cut's draws the coarsest cut, one at or above the mesh's triangle count the full mesh.
+  // with keep_hidden, triangles kept, counted exactly) as estimated from each cluster's sampled
+  // share in view (stats.estimated, to one contraction): the count drawn follows the estimate
+  // within the samples' error, which grows as the cut coarsens (a coarse triangle straddles
+  // what its samples saw). A budget below the coarsest cut's draws the coarsest cut, one at or
+  // above the mesh's triangle count the full mesh.
   // paper: R_global is the shortest global prefix that keeps triangles / f, f the estimated
   // share in view of the whole mesh (eq. 9 distributes R_global). Errors: an invalid camera
   // (check_camera: bad_parameter, or bad_size for an empty viewport); out smaller than
   // contracted_index_bound or ranges not one per cluster (bad_size).
   // screen_error: O(12 · (64 · A log n + matching) + samples + coarsest triangles + contractions
   // + kept triangles / threads) for A clusters that hold triangles; paper: O(C log C + matching
-  // + contractions + kept triangles / threads); times 3 at most with the corrections. No allocation.
+  // + contractions + kept triangles / threads); twice that when the eye turns out inside a
+  // closed part of the cut. No allocation.
   template <class E = serial_executor>
   result<lod_frame_stats> frame(const lod_camera& camera, std::uint64_t triangles, std::span<std::uint32_t> out,
                                 std::span<index_range> ranges, E&& exec = E{}) {
@@ -132,24 +133,17 @@ class view_dependent_lod {
     bool back_faces_hidden = eye_outside_coarsest(samples_, view);
     if (opt_.keep_hidden) std::fill(share_.begin(), share_.end(), 1.0);
     else visible_shares(samples_, view, back_faces_hidden, active, share_);
-    // The shares are estimated from samples of the full mesh, which a coarse cut's triangles
-    // follow only roughly: a frame drawing more than asked is selected again for the count
-    // scaled by asked / drawn (at most twice), with the shares counted again if the cut showed
-    // the eye inside a closed part where the coarsest cut did not (back faces then drawn).
-    std::uint64_t target = triangles;
+    // The shares assume back faces hidden where the eye is outside the coarsest cut's closed
+    // parts; if this cut shows the eye inside one (back faces then drawn), they are counted again
+    // and the frame selected once more.
     for (int attempt = 0;; ++attempt) {
-      if (attempt > 0 && !opt_.keep_hidden && back_faces_hidden != work_.back_faces_hidden)
-        visible_shares(samples_, view, back_faces_hidden = work_.back_faces_hidden, active, share_);
-      if (status s = select(camera, target, st); !s.ok()) return s;
+      if (status s = select(camera, triangles, st); !s.ok()) return s;
       auto n = opt_.keep_hidden ? contract_indices(*h_, stop_, work_, out, ranges, exec)
                                 : contract_visible_indices(*h_, stop_, work_, view, one_sided_, out, ranges, exec);
       if (!n.ok()) return n.error();
       st.indices = *n;
-      const std::uint64_t drawn = *n / 3;
-      if (drawn <= triangles || attempt == 2 || opt_.keep_hidden || target == 0) break;
-      const auto scaled = static_cast<std::uint64_t>(static_cast<double>(target) * static_cast<double>(triangles) /
-                                                     static_cast<double>(drawn));
-      target = std::min(scaled, target - 1);
+      if (attempt == 1 || opt_.keep_hidden || work_.back_faces_hidden == back_faces_hidden) break;
+      visible_shares(samples_, view, back_faces_hidden = work_.back_faces_hidden, active, share_);
     }
     return st;
   }
