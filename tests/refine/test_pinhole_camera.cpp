@@ -8,23 +8,13 @@
 #include <cmath>
 #include <random>
 #include <glm/geometric.hpp>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/mat4x4.hpp>
 #include <glm/trigonometric.hpp>
 #include "infolerp/refine/pinhole_camera.hpp"
+#include "support/glm_projection.hpp"
 
 using namespace infolerp;  // NOLINT: test file
 
 namespace {
-
-// Continuous pixel coordinates (y down) of the point eye + dir, from glm::lookAt and
-// glm::perspective in double (OpenGL clip space, NDC [-1, 1] mapped to [0, width] x [0, height]).
-glm::dvec2 glm_pixel(const pinhole_camera& c, glm::vec3 dir) {
-  const glm::dmat4 vp = glm::perspective(glm::radians(double(c.vertical_fov_degrees)), double(c.width) / double(c.height), 1e-3, 1e3) *
-                        glm::lookAt(glm::dvec3(c.eye), glm::dvec3(c.target), glm::dvec3(c.up));
-  const glm::dvec4 h = vp * glm::dvec4(glm::dvec3(c.eye) + glm::dvec3(dir), 1.0);
-  return {(h.x / h.w + 1.0) * 0.5 * c.width, (1.0 - h.y / h.w) * 0.5 * c.height};
-}
 
 double angle(glm::vec3 a, glm::vec3 b) {
   const glm::dvec3 x = glm::normalize(glm::dvec3(a)), y = glm::normalize(glm::dvec3(b));
@@ -58,7 +48,7 @@ TEST_CASE("pinhole_camera: the ray through pixel (x, y) projects to (x + 1/2, y 
       CHECK(got.origin == c.eye);
       CHECK(glm::length(got.direction) == Approx(1.0f).margin(1e-6));
       CHECK(glm::dot(glm::dvec3(got.direction), f) > 0.0);  // in front of the eye
-      const glm::dvec2 p = glm_pixel(c, got.direction);
+      const glm::dvec3 p = support::glm_pixel(c, glm::dvec3(c.eye) + glm::dvec3(got.direction));
       CHECK(p.x == Approx(double(x) + 0.5).margin(margin));
       CHECK(p.y == Approx(double(y) + 0.5).margin(margin));
       CHECK(direct.origin == got.origin);

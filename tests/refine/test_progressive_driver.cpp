@@ -17,6 +17,7 @@
 #include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/brute_force_tracer.hpp"
+#include "support/glm_projection.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
 
@@ -65,20 +66,8 @@ progressive_refiner make_refiner(const indexed_mesh& m, driver_options o, subdiv
   return std::move(*r);
 }
 
-// Triangle (a, b, c)'s area in pixels under the camera, from glm's own view and projection
-// matrices (independent of pinhole_frame): OpenGL clip space, NDC to pixels with y down.
-double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) {
-  const glm::dmat4 vp = glm::perspective(glm::radians(double(c.vertical_fov_degrees)), double(c.width) / double(c.height), 1e-3, 1e3) *
-                        glm::lookAt(glm::dvec3(c.eye), glm::dvec3(c.target), glm::dvec3(c.up));
-  glm::dvec2 q[3];
-  const glm::vec3 p[3] = {a, b, d};
-  for (int i = 0; i < 3; ++i) {
-    const glm::dvec4 h = vp * glm::dvec4(glm::dvec3(p[i]), 1.0);
-    if (!(h.w > 0.0)) return std::numeric_limits<double>::infinity();
-    q[i] = {(h.x / h.w + 1.0) * 0.5 * c.width, (1.0 - h.y / h.w) * 0.5 * c.height};
-  }
-  return 0.5 * std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
-}
+// Triangle (a, b, c)'s area in pixels under the camera, from glm's own matrices.
+double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) { return support::glm_projected_area(c, a, b, d); }
 
 std::vector<glm::vec3> image_of(const progressive_refiner& r, const pinhole_camera& cam) {
   std::vector<glm::vec3> img(std::size_t(cam.width) * cam.height);

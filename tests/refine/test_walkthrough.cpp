@@ -13,9 +13,8 @@
 #include <thread>
 #include <vector>
 #include <glm/geometric.hpp>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/mat4x4.hpp>
 #include "infolerp/refine/progressive_driver.hpp"
+#include "support/glm_projection.hpp"
 #include "support/thread_pool.hpp"
 #include "support/walkthrough_scene.hpp"
 
@@ -504,21 +503,6 @@ glm::vec3 oracle_colour(const progressive_refiner& r, const view_oracle& o, cons
                    v * glm::dvec3(r.vertex_colour(dv.z)));
 }
 
-// Triangle (a, b, c)'s area in pixels from glm's own view and projection matrices (independent
-// of pinhole_frame): OpenGL clip space, NDC to pixels with y down.
-double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) {
-  const glm::dmat4 vp = glm::perspective(glm::radians(double(c.vertical_fov_degrees)), double(c.width) / double(c.height), 1e-3, 1e3) *
-                        glm::lookAt(glm::dvec3(c.eye), glm::dvec3(c.target), glm::dvec3(c.up));
-  glm::dvec2 q[3];
-  const glm::vec3 p[3] = {a, b, d};
-  for (int i = 0; i < 3; ++i) {
-    const glm::dvec4 h = vp * glm::dvec4(glm::dvec3(p[i]), 1.0);
-    if (!(h.w > 0.0)) return std::numeric_limits<double>::infinity();
-    q[i] = {(h.x / h.w + 1.0) * 0.5 * c.width, (1.0 - h.y / h.w) * 0.5 * c.height};
-  }
-  return 0.5 * std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
-}
-
 // RND replayed (criteria.hpp's rule): splitmix64 (Steele, Lea, Flood 2014) from the seed, pixels
 // drawn uniformly by rejection of the 2^64 mod n lowest values, a batch of up to R distinct
 // qualifying leaves in draw order within 8·R draws, and no draw past the view's point budget.
@@ -543,7 +527,8 @@ struct rnd_oracle {
       const std::uint32_t leaf = o.pixel_leaf[x % n];
       if (leaf == invalid_id || !r.mesh().splittable(leaf)) continue;
       const glm::uvec3 v = r.mesh().triangle(leaf).vertices;
-      if (oracle_area(cam, r.mesh().position(v.x), r.mesh().position(v.y), r.mesh().position(v.z)) < double(co.min_pixels)) continue;
+      if (support::glm_projected_area(cam, r.mesh().position(v.x), r.mesh().position(v.y), r.mesh().position(v.z)) < double(co.min_pixels))
+        continue;
       if (std::find(out.begin(), out.end(), leaf) == out.end()) out.push_back(leaf);
     }
     return out;
