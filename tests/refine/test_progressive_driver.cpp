@@ -571,8 +571,9 @@ TEST_CASE("driver: NLD_IS's display rule does not depend on the shader's scale")
   // A floor of 4x4 cells with a shadow edge and a gentle slope: at scale 1 the slope moves a
   // small triangle's corners by about half an 8-bit step, so the display rule decides many
   // triangles. Scaling every colour by 0.1 or 10 scales L_max and every corner spread alike: the
-  // same triangles are selected in the same batches (an absolute quantum would split more at
-  // 10 and fewer at 0.1).
+  // same triangles are selected in the same batches (an absolute quantum splits other triangles
+  // at 10). Steeper slopes put near-ties in S whose order the rounding of the scaled colours
+  // flips, so this scene keeps its slopes gentle.
   const auto m = support::make_plane(4, 4, 2.0f);
   const auto cam = top_camera();
   const auto run = [&](float scale, float quantum) {
