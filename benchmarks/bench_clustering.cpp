@@ -29,6 +29,15 @@
 //   BM_Clustering_RefinedElephant_Counted/E   the same through support::counting_channel, with
 //                                   the JS estimate (E = 1) or without (E = 0: the baseline, exact
 //                                   JS for every comparison), counting exact JS per channel.
+//   BM_Clustering_KnownAnswer       the same three channels and options on a mesh whose answer is
+//                                   known from geometry alone: a cube of 6 faces of 16x16 quads,
+//                                   welded, planar UVs of one scale. Every channel's row
+//                                   is alike within a face (one normal, one stretch; a convex face
+//                                   is seen from the same viewpoints everywhere) and differs
+//                                   across faces, so the clusters are the faces. Counter
+//                                   ari_vs_faces: adjusted Rand index against the face labels (the
+//                                   clustering regression of report.sh: it shares neither the
+//                                   rays nor the region growing with its reference).
 // Tracer: support::embree_scene (Embree 3, 16-ray packets), device with one thread.
 // Figures: benchmarks/NOTES.md.
 #include <benchmark/benchmark.h>
@@ -220,6 +229,67 @@ void BM_Clustering_RefinedElephant_Counted(benchmark::State& state) {
   state.counters["cluster_of_fnv24"] = fnv24(last.cluster_of);
 }
 BENCHMARK(BM_Clustering_RefinedElephant_Counted)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The cube of BM_Clustering_KnownAnswer and its face of each triangle (0..5). Coordinates are
+// multiples of 1/8 and texcoords of 1/16, exact in float, so a face's normals and stretch are
+// equal to the last bit and the known answer does not rest on rounding.
+struct known_answer_scene {
+  indexed_mesh mesh;
+  std::vector<std::uint32_t> face;
+};
+known_answer_scene make_known_answer() {
+  constexpr std::uint32_t n = 16;  // quads per side
+  known_answer_scene k;
+  indexed_mesh cube;
+  for (std::uint32_t f = 0; f < 6; ++f) {
+    const int axis = static_cast<int>(f / 2), u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const float side = f % 2 ? -1.0f : 1.0f;
+    const auto base = static_cast<std::uint32_t>(cube.positions.size());
+    for (std::uint32_t j = 0; j <= n; ++j)
+      for (std::uint32_t i = 0; i <= n; ++i) {
+        glm::vec3 p;
+        p[axis] = side, p[u] = -1.0f + 2.0f * float(i) / float(n), p[v] = -1.0f + 2.0f * float(j) / float(n);
+        cube.positions.push_back(p);
+      }
+    for (std::uint32_t j = 0; j < n; ++j)
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const std::uint32_t a = base + j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+        const float h = 1.0f / float(n);
+        const glm::vec2 ta(float(i) * h, float(j) * h), tb(float(i + 1) * h, float(j) * h), tc(float(i) * h, float(j + 1) * h),
+            td(float(i + 1) * h, float(j + 1) * h);
+        // (u, v, axis) is right-handed: counter-clockwise in (u, v) faces +axis; flipped for -axis.
+        if (side > 0) cube.triangles.insert(cube.triangles.end(), {{a, b, d}, {a, d, c}}), cube.texcoords.insert(cube.texcoords.end(), {ta, tb, td, ta, td, tc});
+        else cube.triangles.insert(cube.triangles.end(), {{a, d, b}, {a, c, d}}), cube.texcoords.insert(cube.texcoords.end(), {ta, td, tb, ta, tc, td});
+        k.face.insert(k.face.end(), 2, f);
+      }
+  }
+  std::vector<std::uint32_t> remap;
+  k.mesh = support::weld_positions(cube, remap);
+  return k;
+}
+
+void BM_Clustering_KnownAnswer(benchmark::State& state) {
+  static const known_answer_scene k = make_known_answer();
+  const auto topo = make_topology(k.mesh);
+  if (!topo) return state.SkipWithError(topo.error().message().c_str());
+  support::embree_device device("threads=1");
+  support::embree_scene tracer(device);
+  if (!tracer.add_mesh(k.mesh) || !tracer.commit()) return state.SkipWithError("embree scene");
+  serial_executor exec;
+  mesh_clustering last;
+  for (auto _ : state) {
+    auto r = cluster_mesh(k.mesh, tracer, exec, cluster_options{}, elephant_visibility,
+                          orientation_channel{.threshold = 0.02, .bins = 256}, stretch_channel{.threshold = 0.1, .bins = 256});
+    if (!r) return state.SkipWithError(r.error().message().c_str());
+    last = std::move(*r);
+    benchmark::DoNotOptimize(last);
+  }
+  state.counters["triangles"] = static_cast<double>(k.mesh.triangles.size());
+  state.counters["clusters"] = last.cluster_count;
+  for (std::size_t i = 0; i < last.channels.size(); ++i) state.counters["after_ch" + std::to_string(i)] = last.channels[i].clusters_after;
+  state.counters["ari_vs_faces"] = support::adjusted_rand_index(last.cluster_of, k.face);
+}
+BENCHMARK(BM_Clustering_KnownAnswer)->Unit(benchmark::kMillisecond);
 
 // One direct channel, exact (K = 0) against binned: time of init + clustering, JS error, ARI.
 // Args: K (0 = exact), rows (0 = per cell, 1 = exact rows over the cells).

@@ -6,6 +6,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include "support/procedural.hpp"
 
 [[gnu::weak]] int pareto_refine(int argc, char** argv);
 [[gnu::weak]] int pareto_upsample(int argc, char** argv);
@@ -27,4 +28,15 @@ inline double linear_psnr(const std::vector<glm::vec3>& a, const std::vector<glm
   }
   const double mse = se / double(a.size());
   return mse <= 0.0 ? 99.0 : 10.0 * std::log10(1.0 / mse);
+}
+
+// Mesh m with detail at every scale of its resolution: noise octaves along the normals
+// (support::add_noise_detail) from 3 mean edge lengths up to 1/8 of the bounding box's diagonal,
+// each octave's amplitude 5% of its wavelength. The scale figures of `saliency` and `pipeline`
+// measure on it beside the midpoint-split meshes, whose new vertices carry no detail.
+inline infolerp::indexed_mesh with_noise_detail(const infolerp::indexed_mesh& m) {
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  return infolerp::support::add_noise_detail(m, 3.0f * infolerp::support::mean_edge_length(m), glm::distance(lo, hi) / 8.0f,
+                                             0.05f);
 }

@@ -1,13 +1,16 @@
-// infolerp_pareto saliency --csv FILE [--mesh PATH]... [--only-given] [--reps N] [--threads N]
-//                          [--setting C]... [--no-lod] [--lod-seeds N]
-// (--only-given: only the --mesh meshes; --setting: the proxy's cells per σ to measure, default
-// 1 2 3 4; --no-lod: leave the LOD column empty, skipping its salient clustering and hierarchies;
-// --lod-seeds: clustering seeds per LOD, default 3)
+// infolerp_pareto saliency --csv FILE [--mesh PATH]... [--only-given] [--only NAME]... [--reps N]
+//                          [--threads N] [--setting C]... [--no-lod] [--lod-seeds N]
+// (--only-given: only the --mesh meshes; --only: only the built-in meshes of these names;
+// --setting: the proxy's cells per σ to measure, default 1 2 3 4; --no-lod: leave the LOD column
+// empty, skipping its salient clustering and hierarchies; --lod-seeds: clustering seeds per LOD,
+// default 3)
 //
 // Mesh saliency (compute_saliency): run time against error of the proxy approximation
 // (saliency_method::proxy, one row per proxy_cells_per_sigma) against exact (saliency_method::exact),
-// on bunny00, bunny00 split 1:4 at edge midpoints once (301,632 triangles) and twice (1,206,528),
-// and each --mesh.
+// on bunny00, bunny00 split 1:4 at edge midpoints once (bunny00_x4, 301,632 triangles) and twice
+// (bunny00_x16, 1,206,528), bunny00_x16_detail (bunny00_x16 with noise along the normals at every
+// scale from 3 edge lengths up, pareto.hpp's with_noise_detail: the midpoint split's new vertices
+// carry no detail, these do), and each --mesh.
 // CSV: mesh,method,setting,vertices,seconds,relative_l2,top10_overlap,lod_salient_distance_ratio
 //   method: exact, proxy, or default (the default options: the automatic choice, whose setting
 //   column names the method it took); setting: proxy_cells_per_sigma (empty for exact); one more
@@ -196,7 +199,7 @@ void mesh_rows(std::FILE* csv, const std::string& name, const indexed_mesh& m, c
 
 int pareto_saliency(int argc, char** argv) {
   std::string csv_path;
-  std::vector<std::string> extra;
+  std::vector<std::string> extra, only;
   std::vector<double> settings;
   int reps = 3;
   unsigned threads = 2;
@@ -207,6 +210,7 @@ int pareto_saliency(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--csv")) csv_path = next();
     else if (!std::strcmp(argv[i], "--mesh")) extra.push_back(next());
     else if (!std::strcmp(argv[i], "--only-given")) builtin = false;
+    else if (!std::strcmp(argv[i], "--only")) only.push_back(next());
     else if (!std::strcmp(argv[i], "--reps")) reps = std::max(1, std::atoi(next().c_str()));
     else if (!std::strcmp(argv[i], "--threads")) threads = static_cast<unsigned>(std::max(1, std::atoi(next().c_str())));
     else if (!std::strcmp(argv[i], "--setting")) settings.push_back(std::atof(next().c_str()));
@@ -215,8 +219,8 @@ int pareto_saliency(int argc, char** argv) {
     else csv_path.clear(), i = argc;
   }
   if (csv_path.empty()) {
-    std::fprintf(stderr, "usage: infolerp_pareto saliency --csv FILE [--mesh PATH]... [--only-given] [--reps N]"
-                 " [--threads N] [--setting C]... [--no-lod] [--lod-seeds N]\n");
+    std::fprintf(stderr, "usage: infolerp_pareto saliency --csv FILE [--mesh PATH]... [--only-given] [--only NAME]..."
+                 " [--reps N] [--threads N] [--setting C]... [--no-lod] [--lod-seeds N]\n");
     return 2;
   }
   if (settings.empty()) settings = {1.0, 2.0, 3.0, 4.0};
@@ -229,9 +233,13 @@ int pareto_saliency(int argc, char** argv) {
     if (!bunny.ok()) return std::fprintf(stderr, "bunny00: %s\n", bunny.error().message().c_str()), 1;
     indexed_mesh x4 = support::subdivide_midpoint(*bunny);
     indexed_mesh x16 = support::subdivide_midpoint(x4);
+    indexed_mesh x16_detail = with_noise_detail(x16);
     meshes.emplace_back("bunny00", std::move(*bunny));
     meshes.emplace_back("bunny00_x4", std::move(x4));
     meshes.emplace_back("bunny00_x16", std::move(x16));
+    meshes.emplace_back("bunny00_x16_detail", std::move(x16_detail));
+    if (!only.empty())
+      std::erase_if(meshes, [&](const auto& nm) { return std::find(only.begin(), only.end(), nm.first) == only.end(); });
   }
   for (const std::string& path : extra) {
     auto m = support::load_mesh(path);

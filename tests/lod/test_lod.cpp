@@ -95,7 +95,9 @@ TEST_CASE("weighting map: amplification and smoothing on hand-made maps", "[lod]
   std::vector<double> s(m.vertex_count(), 0.0);
   s[60] = 1.0, s[3] = 0.5;
   const double sigma = 0.08;
-  const std::vector<double> g = smooth_vertex_values(m, std::span<const double>(s), sigma);
+  const auto smoothed = smooth_vertex_values(m, std::span<const double>(s), sigma);
+  REQUIRE(smoothed.ok());
+  const std::vector<double>& g = *smoothed;
   for (std::size_t v = 0; v < m.vertex_count(); ++v) {
     double num = 0.0, den = 0.0;
     for (std::size_t x = 0; x < m.vertex_count(); ++x) {
@@ -120,13 +122,43 @@ TEST_CASE("weighting map: amplification and smoothing on hand-made maps", "[lod]
   // percentile.
   auto full = weighting_map(m, sal, cl, 8, {.amplify_percentile = 30.0, .amplification = 100.0});
   REQUIRE(full.ok());
-  const std::vector<double> sm = smooth_vertex_values(m, std::span<const double>(sal), 3.0 * 0.003 * mesh_bounds(m).diagonal());
-  auto local = cluster_localized_saliency(m, std::span<const double>(sm), cl, 8);
+  const auto sm = smooth_vertex_values(m, std::span<const double>(sal), 3.0 * 0.003 * mesh_bounds(m).diagonal());
+  REQUIRE(sm.ok());
+  auto local = cluster_localized_saliency(m, std::span<const double>(*sm), cl, 8);
   REQUIRE(local.ok());
   std::vector<double> sorted = *local;
   std::sort(sorted.begin(), sorted.end());
   const double alpha = sorted[static_cast<std::size_t>(std::ceil(0.3 * static_cast<double>(sorted.size()))) - 1];
   for (std::size_t k = 0; k < sorted.size(); ++k) CHECK((*full)[k] == ((*local)[k] >= alpha ? 100.0 * (*local)[k] : (*local)[k]));
+}
+
+TEST_CASE("weighting map: smooth_vertex_values names what is out of range instead of overflowing its grid keys", "[lod]") {
+  const indexed_mesh m = support::make_plane(10, 10, 1.0f);  // diagonal sqrt(2)
+  const std::vector<double> s(m.vertex_count(), 1.0);
+  const std::span<const double> values(s);
+  // 2^21 cells per axis is the keys' limit: σ 1e-3 at 1,000 cells per σ asks for 1.4e6 cells
+  // along the diagonal (fine), at 2,000 for 2.8e6 (too many).
+  const auto fine = smooth_vertex_values(m, values, 1e-3, serial_executor{}, 1, 1000.0);
+  REQUIRE(fine.ok());
+  CHECK(*fine == s);  // a constant stays constant
+  const auto too_fine = smooth_vertex_values(m, values, 1e-3, serial_executor{}, 1, 2000.0);
+  REQUIRE_FALSE(too_fine.ok());
+  CHECK(too_fine.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  const auto too_small = smooth_vertex_values(m, values, 1e-9, serial_executor{}, 1, 4.0);
+  REQUIRE_FALSE(too_small.ok());
+  CHECK(too_small.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    INFO("sigma " << bad);
+    const auto r = smooth_vertex_values(m, values, bad);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message().find("sigma") != std::string::npos);
+  }
+  const auto negative = smooth_vertex_values(m, values, 0.1, serial_executor{}, 1, -1.0);
+  REQUIRE_FALSE(negative.ok());
+  CHECK(negative.error().message().find("proxy_cells_per_sigma") != std::string::npos);
+  const auto short_values = smooth_vertex_values(m, values.first(5), 0.1);
+  REQUIRE_FALSE(short_values.ok());
+  CHECK(short_values.error().message().find("values") != std::string::npos);
 }
 
 TEST_CASE("weighting map: smoothing over the saliency proxy", "[lod]") {

@@ -17,6 +17,7 @@
 #include "infolerp/refine/nld_os_queue.hpp"
 #include "infolerp/refine/progressive_driver.hpp"
 #include "support/brute_force_tracer.hpp"
+#include "support/glm_projection.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
 
@@ -65,20 +66,8 @@ progressive_refiner make_refiner(const indexed_mesh& m, driver_options o, subdiv
   return std::move(*r);
 }
 
-// Triangle (a, b, c)'s area in pixels under the camera, from glm's own view and projection
-// matrices (independent of pinhole_frame): OpenGL clip space, NDC to pixels with y down.
-double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) {
-  const glm::dmat4 vp = glm::perspective(glm::radians(double(c.vertical_fov_degrees)), double(c.width) / double(c.height), 1e-3, 1e3) *
-                        glm::lookAt(glm::dvec3(c.eye), glm::dvec3(c.target), glm::dvec3(c.up));
-  glm::dvec2 q[3];
-  const glm::vec3 p[3] = {a, b, d};
-  for (int i = 0; i < 3; ++i) {
-    const glm::dvec4 h = vp * glm::dvec4(glm::dvec3(p[i]), 1.0);
-    if (!(h.w > 0.0)) return std::numeric_limits<double>::infinity();
-    q[i] = {(h.x / h.w + 1.0) * 0.5 * c.width, (1.0 - h.y / h.w) * 0.5 * c.height};
-  }
-  return 0.5 * std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
-}
+// Triangle (a, b, c)'s area in pixels under the camera, from glm's own matrices.
+double oracle_area(const pinhole_camera& c, glm::vec3 a, glm::vec3 b, glm::vec3 d) { return support::glm_projected_area(c, a, b, d); }
 
 std::vector<glm::vec3> image_of(const progressive_refiner& r, const pinhole_camera& cam) {
   std::vector<glm::vec3> img(std::size_t(cam.width) * cam.height);
@@ -433,7 +422,7 @@ namespace {
 // the next one taken by a linear scan for the largest S (ties: smaller y0, then x0), the
 // triangle under its centre selected when S > S_req, its area (oracle_area) reaches min_pixels,
 // it is not selected already and its corners' colours (read from the refiner) differ by
-// display_quantum or more in some channel unless it covers more than always_refine_fraction of
+// display_quantum · L_max or more in some channel unless it covers more than always_refine_fraction of
 // the pixels (counted here). Up to `batch` ids.
 std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const criteria_options& o, const pinhole_camera& cam,
                                               const progressive_refiner& r) {
@@ -470,7 +459,7 @@ std::vector<std::uint32_t> nld_is_brute_force(const refinement_frame& f, const c
       bool differ = false;
       for (int ch = 0; ch < 3; ++ch) {
         const float c[3] = {r.vertex_colour(v.x)[ch], r.vertex_colour(v.y)[ch], r.vertex_colour(v.z)[ch]};
-        differ |= *std::max_element(c, c + 3) - *std::min_element(c, c + 3) >= o.display_quantum;
+        differ |= *std::max_element(c, c + 3) - *std::min_element(c, c + 3) >= o.display_quantum * f.l_max;
       }
       if (oracle_area(cam, f.mesh->position(v.x), f.mesh->position(v.y), f.mesh->position(v.z)) >= double(o.min_pixels) &&
           (differ || big))
@@ -564,16 +553,45 @@ TEST_CASE("driver: NLD_IS does not split a triangle whose corners show one value
     for (std::uint32_t leaf : r.pixel_leaves())
       if (leaf != invalid_id) ++covered[leaf];
     if (!r.refine_batch(shade)) break;
+    const float l_max = r.frame().l_max;  // as the batch read it
+    REQUIRE(l_max > 0.5f);
     for (std::uint32_t t : r.last_selection()) {
       if (double(covered[t]) > 0.02 * 64.0 * 64.0) continue;
       const glm::uvec3 v = r.mesh().triangle(t).vertices;
       const glm::vec3 lo = glm::min(r.vertex_colour(v.x), glm::min(r.vertex_colour(v.y), r.vertex_colour(v.z)));
       const glm::vec3 hi = glm::max(r.vertex_colour(v.x), glm::max(r.vertex_colour(v.y), r.vertex_colour(v.z)));
-      CHECK(std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z)) >= 0.5f / 255.0f);
+      CHECK(std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z)) >= 0.5f / 255.0f * l_max);
       ++checked;
     }
   }
   CHECK(checked > 0);
+}
+
+TEST_CASE("driver: NLD_IS's display rule does not depend on the shader's scale") {
+  // A floor of 4x4 cells with a shadow edge and a gentle slope: at scale 1 the slope moves a
+  // small triangle's corners by about half an 8-bit step, so the display rule decides many
+  // triangles. Scaling every colour by 0.1 or 10 scales L_max and every corner spread alike: the
+  // same triangles are selected in the same batches (an absolute quantum splits other triangles
+  // at 10). Steeper slopes put near-ties in S whose order the rounding of the scaled colours
+  // flips, so this scene keeps its slopes gentle.
+  const auto m = support::make_plane(4, 4, 2.0f);
+  const auto cam = top_camera();
+  const auto run = [&](float scale, float quantum) {
+    auto shade = [scale](const shading_point& sp) {
+      return scale * (shadowed(sp.position) * (0.6f + 0.004f * sp.position.y) + glm::vec3(0.002f * sp.position.x));
+    };
+    auto r = make_refiner(m, {.criteria = {.criterion = refinement_criterion::nld_is, .s_req = 0.0f, .min_pixels = 2.0f,
+                                           .batch = 8, .display_quantum = quantum}});
+    REQUIRE(r.start(brute_force_tracer{&m}, cam, shade, serial_executor{}).ok());
+    std::vector<std::vector<std::uint32_t>> batches;
+    while (batches.size() < 300 && r.refine_batch(shade)) batches.emplace_back(r.last_selection().begin(), r.last_selection().end());
+    return batches;
+  };
+  const auto one = run(1.0f, 0.5f / 255.0f);
+  REQUIRE(one.size() >= 3);
+  CHECK(one != run(1.0f, 0.0f));  // the rule decides selections in this scene
+  CHECK(one == run(0.1f, 0.5f / 255.0f));
+  CHECK(one == run(10.0f, 0.5f / 255.0f));
 }
 
 TEST_CASE("driver: NLD_IS at s_req 0 and min_pixels 1 ends by itself, colours inside what was delivered") {

@@ -535,8 +535,11 @@ std::size_t coarsen_all(subdivision_mesh& s, const std::function<bool(std::uint3
 }
 }  // namespace
 
-TEST_CASE("subdivision: coarsen undoes splits, keeps the mesh conforming, and splits reuse what it freed") {
-  const indexed_mesh input = infolerp::support::make_plane(6, 6, 2.0f);
+namespace {
+// Random splits, then coarsen() of the originals left of x = 0 (whatever a split edge ties to
+// the right half stays), then of everything, then splits again: the invariants and conformity
+// (check_invariants) hold after each step.
+void check_coarsen(const indexed_mesh& input) {
   auto s = subdivision_mesh::create(input, {.propagation_depth = 2});
   REQUIRE(s.ok());
   random_selections(*s, input, 600, 5, 100);
@@ -576,6 +579,37 @@ TEST_CASE("subdivision: coarsen undoes splits, keeps the mesh conforming, and sp
   for (std::uint32_t c : s->created()) CHECK(s->triangle(c).parent != invalid_id);
   CHECK_FALSE(s->created().empty());
   check_invariants(*s, input);
+}
+
+// The icosphere's triangles whose corners all lie above z = -0.4: a curved mesh with one
+// boundary loop, its vertices renumbered.
+indexed_mesh open_cap() {
+  const indexed_mesh sphere = infolerp::support::make_icosphere(2);
+  indexed_mesh cap;
+  std::vector<std::uint32_t> index(sphere.positions.size(), invalid_id);
+  for (const glm::uvec3& t : sphere.triangles) {
+    if (!(sphere.positions[t.x].z > -0.4f && sphere.positions[t.y].z > -0.4f && sphere.positions[t.z].z > -0.4f)) continue;
+    glm::uvec3 u;
+    for (int k = 0; k < 3; ++k) {
+      if (index[t[k]] == invalid_id) index[t[k]] = static_cast<std::uint32_t>(cap.positions.size()), cap.positions.push_back(sphere.positions[t[k]]);
+      u[k] = index[t[k]];
+    }
+    cap.triangles.push_back(u);
+  }
+  return cap;
+}
+}  // namespace
+
+TEST_CASE("subdivision: coarsen undoes splits, keeps the mesh conforming, and splits reuse what it freed") {
+  SECTION("a flat grid") { check_coarsen(infolerp::support::make_plane(6, 6, 2.0f)); }
+  SECTION("a closed curved mesh (icosphere)") { check_coarsen(infolerp::support::make_icosphere(2)); }
+  SECTION("an open curved mesh (icosphere cap)") {
+    const indexed_mesh cap = open_cap();
+    auto topo = infolerp::make_topology(cap);
+    REQUIRE(topo.ok());
+    REQUIRE_FALSE(infolerp::boundary_edges(*topo).empty());
+    check_coarsen(cap);
+  }
 }
 
 TEST_CASE("subdivision: coarsen collapses whole subtrees, and nothing when a predicate refuses") {

@@ -14,6 +14,7 @@
 #include <vector>
 #include <glm/geometric.hpp>
 #include "infolerp/refine/progressive_driver.hpp"
+#include "support/glm_projection.hpp"
 #include "support/thread_pool.hpp"
 #include "support/walkthrough_scene.hpp"
 
@@ -404,15 +405,19 @@ TEST_CASE("walkthrough: L_max is the current image's largest luminance; NLD_IS s
 namespace {
 
 // The agent keeps its view state incrementally (pixels re-located under split leaves, a heap of
-// NLD_OS candidates, a max-tree for L_max, the shown cut updated under what changed). The oracle
-// below recomputes that state from scratch, as the straightforward agent that rescanned the whole
-// hierarchy and image every batch did: every pixel located from its hit's original triangle, the
-// pixel counts and visible set counted, each vertex's luminance from its colour, the image from
-// the shown cut, and NLD_OS's selection by select_nld_os over the whole visible set.
+// NLD_OS candidates, a max-tree for L_max, the luminance image updated under dirty leaves, the
+// shown cut updated under what changed, RND's random stream). The oracle below recomputes that
+// state from scratch, as the straightforward agent that rescanned the whole hierarchy and image
+// every batch did: every pixel located from its hit's original triangle, the pixel counts and
+// visible set counted, each vertex's luminance from its colour, the shown cut from the
+// subdivision state by the paper's display rule (§3: a triangle is displayed once shaded, and
+// gives way to its children once they are shaded), the image from that cut, and the criteria's
+// selections over the whole frame (RND's from its own copy of the seeded stream).
 struct view_oracle {
   std::vector<hit> hits;
-  std::vector<std::uint32_t> pixel_leaf, leaf_pixels, visible;
+  std::vector<std::uint32_t> pixel_leaf, leaf_pixels, visible, display;
   std::vector<float> vertex_luminance;
+  std::set<std::uint32_t> shown;
 
   void trace(const pinhole_camera& cam) {
     std::vector<ray> rays(std::size_t(W) * H);
@@ -422,8 +427,8 @@ struct view_oracle {
     trace_intersect(scene(), std::span<const ray>(rays), std::span<hit>(hits));
   }
 
-  // The frame the straightforward agent would hand the criterion now (L_max taken from the agent's
-  // frame once checked against the image, so that the selections compare on the same inputs).
+  // The frame the straightforward agent would hand the criterion now (L_max and the pixel
+  // luminances are set by the caller), and the shown cut.
   refinement_frame frame(const progressive_refiner& r) {
     const subdivision_mesh& m = r.mesh();
     pixel_leaf.assign(hits.size(), invalid_id);
@@ -436,23 +441,57 @@ struct view_oracle {
     vertex_luminance.assign(m.vertex_count(), 0.0f);
     for (std::size_t v = 0; v < m.vertex_count(); ++v)
       if (r.vertex_shaded(v)) vertex_luminance[v] = luminance(r.vertex_colour(v));
+    cut(r);
     refinement_frame f = r.frame();
     f.pixel_leaf = pixel_leaf;
     f.leaf_pixels = leaf_pixels;
     f.visible = visible;
     f.vertex_luminance = vertex_luminance;
+    f.pixel_luminance = {};
     return f;
+  }
+
+  // The display rule from the hierarchy and the shaded vertices alone: walking down from a
+  // visible leaf's original triangle, a triangle whose corners are all shaded is displayed; the
+  // walk goes on to its children when every child in view (a visible leaf in its subtree) is
+  // shaded too, and stops at a triangle not shaded. display[leaf] is the last displayed triangle.
+  void cut(const progressive_refiner& r) {
+    const subdivision_mesh& m = r.mesh();
+    std::vector<char> in_view(m.triangle_count(), 0);
+    for (std::uint32_t leaf : visible)
+      for (std::uint32_t t = leaf; t != invalid_id && !in_view[t]; t = m.triangle(t).parent) in_view[t] = 1;
+    const auto ready = [&](std::uint32_t t) {
+      const glm::uvec3 v = m.triangle(t).vertices;
+      return r.vertex_shaded(v.x) && r.vertex_shaded(v.y) && r.vertex_shaded(v.z);
+    };
+    display.assign(m.triangle_count(), invalid_id);
+    shown.clear();
+    std::vector<std::uint32_t> path;
+    for (std::uint32_t leaf : visible) {
+      path.clear();
+      for (std::uint32_t t = leaf; t != invalid_id; t = m.triangle(t).parent) path.push_back(t);
+      std::uint32_t d = invalid_id;
+      for (auto it = path.rbegin(); it != path.rend() && ready(*it); ++it) {
+        d = *it;
+        const subdivision_triangle& n = m.triangle(d);
+        bool children_ready = true;
+        for (std::uint32_t c = n.first_child; c < n.first_child + n.child_count; ++c) children_ready &= !in_view[c] || ready(c);
+        if (!children_ready) break;
+      }
+      display[leaf] = d;
+      if (d != invalid_id) shown.insert(d);
+    }
   }
 };
 
-// The colour of pixel p from scratch: the shown ancestor of its leaf, the hit point's weights in it
-// from the positions, the corners' colours interpolated (background where nothing is shown).
-glm::vec3 oracle_colour(const progressive_refiner& r, const std::set<std::uint32_t>& shown, const hit& h) {
+// The colour of a pixel from scratch: the displayed triangle over its leaf (view_oracle::cut),
+// the hit point's weights in it from the positions, the corners' colours interpolated
+// (background where nothing is displayed).
+glm::vec3 oracle_colour(const progressive_refiner& r, const view_oracle& o, const hit& h) {
   if (!h.valid()) return driver_options{}.background;
   const subdivision_mesh& m = r.mesh();
   const point_location loc = m.locate(h.triangle, h.barycentric);
-  std::uint32_t d = loc.leaf;
-  while (d != invalid_id && !shown.count(d)) d = m.triangle(d).parent;
+  const std::uint32_t d = o.display[loc.leaf];
   if (d == invalid_id) return driver_options{}.background;
   const glm::uvec3 lv = m.triangle(loc.leaf).vertices, dv = m.triangle(d).vertices;
   const glm::dvec3 p = double(loc.weights.x) * glm::dvec3(m.position(lv.x)) +
@@ -464,17 +503,53 @@ glm::vec3 oracle_colour(const progressive_refiner& r, const std::set<std::uint32
                    v * glm::dvec3(r.vertex_colour(dv.z)));
 }
 
+// RND replayed (criteria.hpp's rule): splitmix64 (Steele, Lea, Flood 2014) from the seed, pixels
+// drawn uniformly by rejection of the 2^64 mod n lowest values, a batch of up to R distinct
+// qualifying leaves in draw order within 8·R draws, and no draw past the view's point budget.
+struct rnd_oracle {
+  std::uint64_t state = 0, drawn = 0;
+  bool exhausted = false;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  std::vector<std::uint32_t> select(const progressive_refiner& r, const view_oracle& o, const pinhole_camera& cam,
+                                    const criteria_options& co) {
+    const std::uint64_t n = std::uint64_t(W) * H, budget = static_cast<std::uint64_t>(double(co.rnd_point_fraction) * double(n));
+    std::vector<std::uint32_t> out;
+    for (std::uint64_t draws = 0; out.size() < co.batch && draws < 8ull * co.batch; ++draws) {
+      if (drawn >= budget) return exhausted = true, out;
+      ++drawn;
+      std::uint64_t x = next();
+      while (x < (0 - n) % n) x = next();
+      const std::uint32_t leaf = o.pixel_leaf[x % n];
+      if (leaf == invalid_id || !r.mesh().splittable(leaf)) continue;
+      const glm::uvec3 v = r.mesh().triangle(leaf).vertices;
+      if (support::glm_projected_area(cam, r.mesh().position(v.x), r.mesh().position(v.y), r.mesh().position(v.z)) < double(co.min_pixels))
+        continue;
+      if (std::find(out.begin(), out.end(), leaf) == out.end()) out.push_back(leaf);
+    }
+    return out;
+  }
+};
+
 // Every delta of the 120-frame path as infolerp_pareto walk drives it (a delta after every
 // delivery and every batch), replayed into a set, and after every delivery the agent's state
-// against the oracle's; each NLD_OS batch against select_nld_os over the oracle's frame. The
-// oracle uses the same hits and colours, so the comparisons hold on any CPU: pixel leaves,
-// counts, visible set, luminances, L_max and selections exactly, colours within 1e-4 relative (the
-// oracle interpolates in double from positions, the agent in float from stored weights).
+// against the oracle's; each batch against the oracle's selection (NLD_OS by select_nld_os and
+// NLD_IS by select_nld_is over the oracle's frame, RND replayed from its seed). The oracle uses
+// the same hits and colours, so the comparisons hold on any CPU: pixel leaves, counts, visible
+// set, shown set, luminances and selections exactly; colours and L_max within 1e-4 relative (the
+// oracle interpolates in double from positions, the agent in float from stored weights). The
+// incremental luminance image (NLD_IS) equals, bit for bit, the luminances of the image
+// recomputed from the agent's cut before the batch.
 void check_walk_against_oracle(refinement_criterion c, bool restart) {
   serial_executor ex;
   const criteria_options co{.criterion = c, .s_req = 0.05f, .always_refine_fraction = 0.02f, .batch = 64};
   auto r = make_agent({.criteria = co});
   view_oracle oracle;
+  rnd_oracle rnd{.state = co.seed};
   std::set<std::uint32_t> replayed;
   display_delta delta;
   const auto take = [&] {
@@ -483,15 +558,18 @@ void check_walk_against_oracle(refinement_criterion c, bool restart) {
     for (const auto* list : {&delta.added_from_cache, &delta.newly_shaded})
       for (std::uint32_t t : *list) REQUIRE(replayed.insert(t).second);
   };
-  std::size_t batches = 0, mismatched_pixels = 0, mismatched_colours = 0, mismatched_selections = 0;
-  float worst_colour = 0.0f;
+  std::size_t batches = 0, mismatched_pixels = 0, mismatched_colours = 0, mismatched_selections = 0, mismatched_cuts = 0,
+              mismatched_luminance_images = 0, coarser = 0;
+  float worst_colour = 0.0f, worst_l_max = 0.0f;
   std::vector<std::uint32_t> expected;
   std::vector<glm::vec3> img(std::size_t(W) * H);
+  std::vector<float> pixel_luminance(img.size());
   constexpr std::uint32_t frames = 120;
   for (std::uint32_t f = 0; f < frames; ++f) {
     const pinhole_camera cam = support::walkthrough_path(f, frames, W, H);
     REQUIRE((restart ? r.start(scene(), cam, ex) : r.set_view(scene(), cam, ex)).ok());
-    if (restart) replayed.clear();  // a restart begins a new display
+    if (restart) replayed.clear(), rnd = {.state = co.seed};  // a restart begins a new display and stream
+    rnd.drawn = 0, rnd.exhausted = false;                      // the point budget is per view
     take();
     oracle.trace(cam);
     for (;;) {
@@ -501,6 +579,8 @@ void check_walk_against_oracle(refinement_criterion c, bool restart) {
       refinement_frame of = oracle.frame(r);
       const std::span<const std::uint32_t> shown = r.shown_triangles();
       REQUIRE(std::equal(shown.begin(), shown.end(), replayed.begin(), replayed.end()));
+      mismatched_cuts += !std::equal(shown.begin(), shown.end(), oracle.shown.begin(), oracle.shown.end());
+      coarser += oracle.shown.size() > shown.size();
       mismatched_pixels += !std::equal(of.pixel_leaf.begin(), of.pixel_leaf.end(), r.pixel_leaves().begin(), r.pixel_leaves().end());
       const std::span<const std::uint32_t> vis = r.visible_leaves();
       REQUIRE(std::equal(vis.begin(), vis.end(), oracle.visible.begin(), oracle.visible.end()));
@@ -510,38 +590,50 @@ void check_walk_against_oracle(refinement_criterion c, bool restart) {
         for (int k = 0; k < 3; ++k)
           if (r.vertex_shaded(v[k])) REQUIRE(r.frame().vertex_luminance[v[k]] == oracle.vertex_luminance[v[k]]);
       }
-      // The image against the oracle's colours; L_max is its largest luminance.
+      // The image against the oracle's colours; L_max against the oracle image's largest luminance.
       r.reconstruct(img);
-      float l_max = 0.0f;
+      float l_max = 0.0f, oracle_l_max = 0.0f;
       for (std::size_t p = 0; p < img.size(); ++p) {
-        const glm::vec3 e = oracle_colour(r, replayed, oracle.hits[p]);
+        const glm::vec3 e = oracle_colour(r, oracle, oracle.hits[p]);
         const float diff = glm::length(e - img[p]) / std::max(1.0f, glm::length(e));
         worst_colour = std::max(worst_colour, diff);
         mismatched_colours += !(diff <= 1e-4f);
-        l_max = std::max(l_max, luminance(img[p]));
+        pixel_luminance[p] = luminance(img[p]);
+        l_max = std::max(l_max, pixel_luminance[p]);
+        oracle_l_max = std::max(oracle_l_max, luminance(e));
       }
-      // The batch the straightforward agent would select (NLD_OS; RND's stream is the agent's own).
-      expected.clear();
+      // The batch the straightforward agent would select, on the agent's exact L_max and pixel
+      // luminances (checked against the oracle's here and after the batch) so ties compare alike.
       of.l_max = l_max;
+      expected.clear();
       if (c == refinement_criterion::nld_os) select_nld_os(of, co, expected, co.batch);
+      if (c == refinement_criterion::nld_is) of.pixel_luminance = pixel_luminance, select_nld_is(of, co, expected);
+      if (c == refinement_criterion::rnd) expected = rnd.select(r, oracle, cam, co);
       const refine_progress step = r.refine({}, ex);
-      REQUIRE(r.frame().l_max == l_max);  // the max-tree's L_max, taken before the batch
+      const refinement_frame af = r.frame();  // L_max and the luminance image as the batch read them
+      worst_l_max = std::max(worst_l_max, std::abs(af.l_max - oracle_l_max) / std::max(1.0f, oracle_l_max));
+      REQUIRE(std::abs(af.l_max - oracle_l_max) <= 1e-4f * std::max(1.0f, oracle_l_max));
+      if (c == refinement_criterion::nld_is)
+        mismatched_luminance_images += !std::equal(af.pixel_luminance.begin(), af.pixel_luminance.end(), pixel_luminance.begin(),
+                                                   pixel_luminance.end());
       if (step == refine_progress::refined) {
         ++batches;
         const std::span<const std::uint32_t> got = r.last_selection();
-        if (c == refinement_criterion::nld_os)
-          mismatched_selections += !std::equal(got.begin(), got.end(), expected.begin(), expected.end());
+        mismatched_selections += !std::equal(got.begin(), got.end(), expected.begin(), expected.end());
       }
       take();
       if (step != refine_progress::refined) break;
     }
-    if (c == refinement_criterion::nld_os) CHECK(expected.empty());  // it finished where the oracle selects nothing
+    CHECK(expected.empty());  // it finished where the oracle selects nothing
   }
-  INFO("batches " << batches << ", worst colour difference " << worst_colour);
+  INFO("batches " << batches << ", worst colour difference " << worst_colour << ", worst L_max difference " << worst_l_max);
   CHECK(batches >= 10);  // refinement ran on the path, not only stage 1
   CHECK(mismatched_pixels == 0);
+  CHECK(mismatched_cuts == 0);
+  CHECK(coarser == 0);
   CHECK(mismatched_colours == 0);
   CHECK(mismatched_selections == 0);
+  CHECK(mismatched_luminance_images == 0);
 }
 
 }  // namespace
@@ -550,6 +642,8 @@ TEST_CASE("walkthrough: on the 120-frame path the agent's state and selections e
   SECTION("NLD_OS, views kept") { check_walk_against_oracle(refinement_criterion::nld_os, false); }
   SECTION("NLD_OS, restart per frame") { check_walk_against_oracle(refinement_criterion::nld_os, true); }
   SECTION("RND, views kept") { check_walk_against_oracle(refinement_criterion::rnd, false); }
+  SECTION("RND, restart per frame") { check_walk_against_oracle(refinement_criterion::rnd, true); }
+  SECTION("NLD_IS, views kept") { check_walk_against_oracle(refinement_criterion::nld_is, false); }
 }
 
 TEST_CASE("walkthrough: Table 1's Δ_total counts the triangles sent in the current view") {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 #include <utility>
+#include <vector>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 namespace infolerp::support {
@@ -139,6 +141,63 @@ void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m) {
   for (const auto& t : src.triangles) dst.triangles.push_back(t + glm::uvec3(base));
   if (keep_uv) dst.texcoords.insert(dst.texcoords.end(), src.texcoords.begin(), src.texcoords.end());
   dst.normals.clear();
+}
+
+float mean_edge_length(const indexed_mesh& m) {
+  double sum = 0.0;
+  for (const auto& t : m.triangles)
+    sum += static_cast<double>(glm::distance(m.positions[t.x], m.positions[t.y]) + glm::distance(m.positions[t.y], m.positions[t.z]) +
+                               glm::distance(m.positions[t.z], m.positions[t.x]));
+  return m.triangles.empty() ? 0.0f : static_cast<float>(sum / (3.0 * static_cast<double>(m.triangles.size())));
+}
+
+namespace {
+// A lattice value in [-1, 1] for integer point (x, y, z) of octave `o`.
+float lattice_value(std::int32_t x, std::int32_t y, std::int32_t z, std::uint32_t o) {
+  std::uint32_t h = o * 0x9E3779B9u;
+  for (std::uint32_t c : {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)}) {
+    h ^= c + 0x7F4A7C15u + (h << 6) + (h >> 2);
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+  }
+  h *= 0xC2B2AE35u;
+  h ^= h >> 16;
+  return static_cast<float>(h) / 2147483647.5f - 1.0f;
+}
+
+// Value noise at p (lattice spacing 1): the lattice values blended with the quintic fade.
+float value_noise(glm::vec3 p, std::uint32_t o) {
+  const glm::vec3 f = glm::floor(p), u = p - f;
+  const glm::vec3 w = u * u * u * (u * (u * 6.0f - 15.0f) + 10.0f);
+  const auto x = static_cast<std::int32_t>(f.x), y = static_cast<std::int32_t>(f.y), z = static_cast<std::int32_t>(f.z);
+  float sum = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+    sum += (dx ? w.x : 1.0f - w.x) * (dy ? w.y : 1.0f - w.y) * (dz ? w.z : 1.0f - w.z) * lattice_value(x + dx, y + dy, z + dz, o);
+  }
+  return sum;
+}
+}  // namespace
+
+indexed_mesh add_noise_detail(const indexed_mesh& in, float finest, float coarsest, float relative_amplitude, std::uint32_t seed) {
+  indexed_mesh out;
+  out.positions = in.positions;
+  out.triangles = in.triangles;
+  std::vector<glm::vec3> normal(in.positions.size(), glm::vec3(0.0f));
+  for (const auto& t : in.triangles) {
+    const glm::vec3 n = glm::cross(in.positions[t.y] - in.positions[t.x], in.positions[t.z] - in.positions[t.x]);
+    normal[t.x] += n, normal[t.y] += n, normal[t.z] += n;
+  }
+  for (std::size_t v = 0; v < in.positions.size(); ++v) {
+    const float len = glm::length(normal[v]);
+    if (!(len > 0.0f)) continue;
+    float d = 0.0f;
+    std::uint32_t o = seed * 64u;
+    for (float wavelength = finest; wavelength <= coarsest; wavelength *= 2.0f, ++o)
+      d += relative_amplitude * wavelength * value_noise(in.positions[v] / wavelength, o);
+    out.positions[v] += d / len * normal[v];
+  }
+  return out;
 }
 
 indexed_mesh subdivide_midpoint(const indexed_mesh& in) {

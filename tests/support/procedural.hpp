@@ -20,6 +20,15 @@ indexed_mesh make_box(glm::vec3 lo, glm::vec3 hi);
 // Midpoint 1:4 subdivision: each triangle into four, new vertices at edge midpoints (shared
 // between the two triangles of an edge). Texcoords and normals are dropped. O(T log T).
 indexed_mesh subdivide_midpoint(const indexed_mesh& in);
+// Mean edge length over the triangles' corners (each interior edge counted twice). O(T).
+float mean_edge_length(const indexed_mesh& m);
+// Detail at every scale from `finest` up to `coarsest` (world units): each vertex moves along its
+// area-weighted normal by a sum of octaves of 3D value noise of its rest position, wavelengths
+// finest, 2·finest, 4·finest, ... up to coarsest, each with amplitude `relative_amplitude` times
+// its wavelength (a 1/f spectrum: every scale equally rough). Deterministic in `seed`; texcoords
+// and normals are dropped. O(V · octaves + T).
+indexed_mesh add_noise_detail(const indexed_mesh& in, float finest, float coarsest, float relative_amplitude,
+                              std::uint32_t seed = 1);
 // Appends `src` transformed by `m` to `dst` (texcoords kept only if both have them, or dst is empty).
 void append(indexed_mesh& dst, const indexed_mesh& src, const glm::mat4& m = glm::mat4(1.0f));
 

@@ -85,12 +85,26 @@ inline void amplify_weights(std::span<double> values, double percentile, double 
 // Smoothing step alone (step 1): the Gaussian ball average of per-vertex values with
 // σ = sigma (mesh units); unreferenced vertices keep their value. proxy_cells_per_sigma 0: exact
 // ball sums, O(pairs within 2σ); > 0: over the proxy with that many cells per σ, O(V log V).
-// Preconditions: valid mesh, values.size() == V, sigma > 0 and finite, proxy_cells_per_sigma
-// >= 0 and finite with (bounding-box diagonal) · proxy_cells_per_sigma / sigma below
-// detail::proxy_max_cells. Allocation O(V). Identical bits for any executor.
+// Precondition: a valid mesh. Errors (bad_parameter): values.size() != V; sigma not positive
+// and finite; proxy_cells_per_sigma negative or not finite, or so large that the proxy grid
+// would pass detail::proxy_max_cells cells along the bounding-box diagonal (its keys hold 21
+// bits per axis). Allocation O(V). Identical bits for any executor.
 template <class M, class E = serial_executor>
-std::vector<double> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
-                                         std::size_t grain = 1, double proxy_cells_per_sigma = 0.0) {
+result<std::vector<double>> smooth_vertex_values(const M& m, std::span<const double> values, double sigma, E&& exec = E{},
+                                                 std::size_t grain = 1, double proxy_cells_per_sigma = 0.0) {
+  if (values.size() != mesh_vertex_count(m))
+    return make_error(errc::bad_parameter, no_element, "smooth_vertex_values: ", values.size(), " values for ",
+                      mesh_vertex_count(m), " vertices");
+  if (!(sigma > 0.0) || !std::isfinite(sigma))
+    return make_error(errc::bad_parameter, no_element, "smooth_vertex_values: sigma ", sigma, " must be positive and finite");
+  if (!(proxy_cells_per_sigma >= 0.0) || !std::isfinite(proxy_cells_per_sigma))
+    return make_error(errc::bad_parameter, no_element, "smooth_vertex_values: proxy_cells_per_sigma ", proxy_cells_per_sigma,
+                      " must be >= 0 and finite");
+  if (proxy_cells_per_sigma > 0.0)
+    if (auto method = detail::choose_saliency_method(saliency_method::proxy, 0, 0, proxy_cells_per_sigma, sigma,
+                                                     mesh_bounds(m).diagonal(), "smooth_vertex_values");
+        !method.ok())
+      return method.error();
   return detail::smooth_points(exec, detail::referenced_points(m, detail::referenced_vertices(m), values), values, sigma,
                                grain, proxy_cells_per_sigma);
 }

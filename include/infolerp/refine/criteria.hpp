@@ -23,8 +23,10 @@
 //    last batch may overshoot by its own requests; the paper gives no value, so the default is
 //    none).
 //  - NLD_IS does not split a triangle whose corner colours differ by less than
-//    `display_quantum` in every channel (default half an 8-bit step of values in [0, 1]; smaller
-//    for sRGB's dark steps; 0: the paper's NLD_IS): it shows one displayed value, and its
+//    `display_quantum` · L_max in every channel (default half an 8-bit step of a display whose
+//    white is the image's L_max; 0: the paper's NLD_IS). Relative to L_max, as NLD is, so that
+//    scaling the shader by any factor selects the same triangles. Such a triangle shows one
+//    displayed value, and its
 //    quadrants' S is high only because their corners fall on other triangles. Triangles above
 //    `always_refine_fraction` of the image are exempt (§4.1), so a feature no vertex sees yet is
 //    still looked for in large triangles; in smaller ones it is left unfound, as NLD_OS leaves it.
@@ -74,7 +76,7 @@ struct criteria_options {
   float rnd_point_fraction = 1.0f;       // RND: stop after drawing this fraction of the pixel count, in [0, max_rnd_point_fraction]
   float nld_is_pixel_fraction = std::numeric_limits<float>::infinity();  // NLD_IS: stop once the view's requests reach this fraction of the pixels
   float random_share = 0.0f;             // NLD_OS: share of each batch given to a random pass (0: none)
-  float display_quantum = 0.5f / 255.0f; // NLD_IS: skip triangles whose corners agree within this in every channel (0: none)
+  float display_quantum = 0.5f / 255.0f; // NLD_IS: skip triangles whose corners agree within this times L_max in every channel (0: none)
   std::uint64_t seed = 1;                // RND: random sequence
 
   // Largest rnd_point_fraction: a million draws per pixel, far past where RND finds anything new,
@@ -150,14 +152,14 @@ inline bool qualifies(const refinement_frame& f, const criteria_options& o, std:
 inline bool large(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
   return double(f.leaf_pixels[t]) > double(o.always_refine_fraction) * double(f.width) * double(f.height);
 }
-// NLD_IS's display rule: leaf t's corner colours differ by less than display_quantum in every
-// channel, and it is not large (see the prologue). O(1).
+// NLD_IS's display rule: leaf t's corner colours differ by less than display_quantum · L_max in
+// every channel, and it is not large (see the prologue). O(1).
 inline bool shows_one_value(const refinement_frame& f, const criteria_options& o, std::uint32_t t) {
   if (f.vertex_colour.empty() || large(f, o, t)) return false;
   const glm::uvec3 v = f.mesh->triangle(t).vertices;
   const glm::vec3 a = f.vertex_colour[v.x], b = f.vertex_colour[v.y], c = f.vertex_colour[v.z];
   const glm::vec3 spread = glm::max(a, glm::max(b, c)) - glm::min(a, glm::min(b, c));
-  return std::max(spread.x, std::max(spread.y, spread.z)) < o.display_quantum;
+  return std::max(spread.x, std::max(spread.y, spread.z)) < o.display_quantum * f.l_max;
 }
 }  // namespace detail
 
