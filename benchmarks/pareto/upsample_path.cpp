@@ -1,6 +1,6 @@
 // infolerp_pareto upsample --path --csv FILE [--size W H] [--frames N] [--threads N] [--ao N] [--soft N]
 //                          [--reps R] [--pictures DIR] [--reuse-passes P] [--refresh K] [--depth-tolerance T]
-//                          [--max-age A] [--colour-tolerance C] [--no-colour]
+//                          [--max-age A] [--colour-tolerance C]
 //
 // Frames along two camera paths through the built-in demo scene (reference shading: AO 64 rays,
 // soft shadow 16 rays, hard-shadow sun; feature clusters at the demo's thresholds), every frame
@@ -11,6 +11,7 @@
 //   ibuffer            the I-Buffer every frame from nothing, at its best setting with >= 40 dB
 //   ibuffer_reuse      the same upsampler setting through frame_reuse.hpp (terms, and colours
 //                      the view cannot change by a display step, from the previous frame)
+//   ibuffer_reuse_terms  the same with the terms only (frame_reuse without a Pixel type)
 // Paths (120 frames by default): `orbit`, a quarter degree of orbit a frame (0-49), standing
 // still for 20 frames (50-69), orbiting on while moving to 0.8 of the distance (70-119); `walk`,
 // 1% of the scene's diagonal of travel a frame around the target and 1 degree of view turn a
@@ -332,6 +333,9 @@ sup::image marked(const std::vector<glm::vec3>& img, std::span<const std::uint8_
   return out;
 }
 
+const char* const method_names[] = {"per_pixel", "per_pixel_packets", "ibuffer", "ibuffer_reuse", "ibuffer_reuse_terms"};
+constexpr int methods = 5;
+
 int write_plot(const std::string& csv, int w, int h) {
   const std::string base = csv.size() > 4 && csv.ends_with(".csv") ? csv.substr(0, csv.size() - 4) : csv;
   std::ofstream gp(base + ".gp");
@@ -342,14 +346,15 @@ int write_plot(const std::string& csv, int w, int h) {
   for (const char* path : {"orbit", "walk"}) {
     gp << "set ylabel '" << path << ": seconds (log)'\nset logscale y\nplot ";
     bool first = true;
-    for (const char* m : {"per_pixel", "per_pixel_packets", "ibuffer", "ibuffer_reuse"}) {
+    for (const char* m : method_names) {
       gp << (first ? "'" + csv + "'" : std::string("''")) << " using 2:(stringcolumn(1) eq '" << path << "' && stringcolumn(3) eq '"
-         << m << "' ? $4 : 1/0) with points pt 7 ps 0.4 title '" << m << "'" << (std::string(m) == "ibuffer_reuse" ? "\n" : ", ");
+         << m << "' ? $4 : 1/0) with points pt 7 ps 0.4 title '" << m << "'" << (std::string(m) == "ibuffer_reuse_terms" ? "\n" : ", ");
       first = false;
     }
     gp << "unset logscale y\nset ylabel '" << path << ": PSNR dB vs per_pixel'\nplot '" << csv << "' using 2:(stringcolumn(1) eq '"
        << path << "' && stringcolumn(3) eq 'ibuffer' ? $5 : 1/0) with points pt 7 ps 0.4 title 'ibuffer', '' using 2:(stringcolumn(1) eq '"
-       << path << "' && stringcolumn(3) eq 'ibuffer_reuse' ? $5 : 1/0) with points pt 7 ps 0.4 title 'ibuffer_reuse', 40 with lines dt 2 title '40 dB'\n";
+       << path << "' && stringcolumn(3) eq 'ibuffer_reuse' ? $5 : 1/0) with points pt 7 ps 0.4 title 'ibuffer_reuse', '' using 2:(stringcolumn(1) eq '"
+       << path << "' && stringcolumn(3) eq 'ibuffer_reuse_terms' ? $5 : 1/0) with points pt 7 ps 0.4 title 'ibuffer_reuse_terms', 40 with lines dt 2 title '40 dB'\n";
   }
   gp << "unset multiplot\n";
   gp.close();
@@ -364,8 +369,6 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-const char* const method_names[] = {"per_pixel", "per_pixel_packets", "ibuffer", "ibuffer_reuse"};
-constexpr int methods = 4;
 using reuse_t = infolerp::frame_reuse<sample, glm::vec3>;
 
 }  // namespace
@@ -373,7 +376,6 @@ using reuse_t = infolerp::frame_reuse<sample, glm::vec3>;
 int pareto_upsample_path(int argc, char** argv) {
   std::string csv, pictures;
   int width = 640, height = 480, threads = 0, ao = 64, soft = 16, frames = 120, reuse_passes = 0, reps = 3;
-  bool colour = true;
   infolerp::frame_reuse_options reuse_options;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
@@ -391,11 +393,10 @@ int pareto_upsample_path(int argc, char** argv) {
     else if (a == "--depth-tolerance" && i + 1 < argc) reuse_options.depth_tolerance = std::strtof(argv[++i], nullptr);
     else if (a == "--max-age" && i + 1 < argc) reuse_options.max_age = std::uint8_t(std::atoi(argv[++i]));
     else if (a == "--colour-tolerance" && i + 1 < argc) reuse_options.colour_tolerance = std::strtof(argv[++i], nullptr);
-    else if (a == "--no-colour") colour = false;
     else {
       std::fprintf(stderr, "usage: infolerp_pareto upsample --path --csv FILE [--size W H] [--frames N] [--threads N] [--ao N] "
                            "[--soft N] [--reps R] [--pictures DIR] [--reuse-passes P] [--refresh K] [--depth-tolerance T] "
-                           "[--max-age A] [--colour-tolerance C] [--no-colour]\n");
+                           "[--max-age A] [--colour-tolerance C]\n");
       return 2;
     }
   }
@@ -464,9 +465,9 @@ int pareto_upsample_path(int argc, char** argv) {
   const setting& s = candidates[chosen];
   setting rs = s;
   if (reuse_passes > 0) rs.passes = std::uint32_t(reuse_passes), rs.name += ", reuse with " + std::to_string(reuse_passes) + " passes";
-  std::printf("ibuffer setting: %s; reuse: refresh %u, max age %u, depth tolerance %.3f, colours %s\n", rs.name.c_str(),
+  std::printf("ibuffer setting: %s; reuse: refresh %u, max age %u, depth tolerance %.3f, colour tolerance %.5f\n", rs.name.c_str(),
               reuse_options.refresh_period, unsigned(reuse_options.max_age), double(reuse_options.depth_tolerance),
-              colour ? "reused where the source allows" : "shaded every frame");
+              double(reuse_options.colour_tolerance));
 
   // The timed runs: [path][frame][method] results; seconds of every repetition.
   struct cell {
@@ -482,9 +483,10 @@ int pareto_upsample_path(int argc, char** argv) {
       auto up_plain = h.upsampler_for(s);
       auto up_reuse = h.upsampler_for(rs, true);
       auto reuse = reuse_t::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
-      auto reuse_plain = infolerp::frame_reuse<sample>::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
-      if (!reuse || !reuse_plain) return std::fprintf(stderr, "%s\n", reuse.error().message().c_str()), 1;
-      std::vector<glm::vec3> ref_img, packets_img, ib_img, re_img;
+      auto up_terms = h.upsampler_for(rs, true);
+      auto reuse_terms = infolerp::frame_reuse<sample>::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
+      if (!reuse || !reuse_terms) return std::fprintf(stderr, "%s\n", reuse.error().message().c_str()), 1;
+      std::vector<glm::vec3> ref_img, packets_img, ib_img, re_img, terms_img;
       for (int f = 0; f < frames; ++f) {
         const auto v = h.view_at(path, float(f));
         std::array<frame_result, methods> r;
@@ -493,27 +495,22 @@ int pareto_upsample_path(int argc, char** argv) {
           if (m == 0) r[0] = h.per_pixel(v, ref_img);
           else if (m == 1) r[1] = h.per_pixel(v, packets_img, true);
           else if (m == 2) r[2] = h.ibuffer(v, s, up_plain, ib_img);
-          else if (colour) r[3] = h.reuse(v, rs, up_reuse, *reuse, re_img);
-          else r[3] = h.reuse(v, rs, up_reuse, *reuse_plain, re_img);
+          else if (m == 3) r[3] = h.reuse(v, rs, up_reuse, *reuse, re_img);
+          else r[4] = h.reuse(v, rs, up_terms, *reuse_terms, terms_img);
         }
         if (rep == 0) {
-          if (std::getenv("DUMP") && f == 2) {
-            sup::image a(width, height), b2(width, height), d(width, height);
-            a.pixels = re_img; b2.pixels = ref_img; d.pixels = re_img;
-            for (std::size_t i = 0; i < d.pixels.size(); ++i) d.pixels[i] = glm::abs(re_img[i] - ref_img[i]) * 10.0f;
-            (void)sup::write_png(a, "/tmp/wt52/re.png"); (void)sup::write_png(b2, "/tmp/wt52/ref.png"); (void)sup::write_png(d, "/tmp/wt52/diff.png");
-          }
           const auto ref_luma = luma_of(ref_img);
           r[0].psnr = 99.0, r[0].ssim = 1.0;
           h.measure(r[1], packets_img, ref_luma);
           h.measure(r[2], ib_img, ref_luma);
           h.measure(r[3], re_img, ref_luma);
-          if (!pictures.empty() && path == "orbit" && f % 15 == 0) strip.push_back(marked(re_img, colour ? reuse->marks() : reuse_plain->marks(), width, height));
+          h.measure(r[4], terms_img, ref_luma);
+          if (!pictures.empty() && path == "orbit" && f % 15 == 0) strip.push_back(marked(re_img, reuse->marks(), width, height));
           for (int m = 0; m < methods; ++m) rows[std::size_t(f)][std::size_t(m)].r = r[std::size_t(m)];
           std::printf("%s frame %3d  per_pixel %.3f s  packets %.3f s  ibuffer %.4f s %.2f dB eval %.4f  reuse %.4f s %.2f dB "
-                      "eval %.4f reused %.4f colours %.3f%s\n", path.c_str(), f, r[0].seconds, r[1].seconds, r[2].seconds,
-                      r[2].psnr, r[2].evaluated, r[3].seconds, r[3].psnr, r[3].evaluated, r[3].reused, r[3].colours,
-                      colour && reuse->stats().repeated ? " (repeated)" : "");
+                      "eval %.4f reused %.4f colours %.3f%s  terms only %.4f s %.2f dB\n", path.c_str(), f, r[0].seconds,
+                      r[1].seconds, r[2].seconds, r[2].psnr, r[2].evaluated, r[3].seconds, r[3].psnr, r[3].evaluated, r[3].reused,
+                      r[3].colours, reuse->stats().repeated ? " (repeated)" : "", r[4].seconds, r[4].psnr);
           std::fflush(stdout);
         }
         for (int m = 0; m < methods; ++m) rows[std::size_t(f)][std::size_t(m)].seconds.push_back(r[std::size_t(m)].seconds);
@@ -538,48 +535,49 @@ int pareto_upsample_path(int argc, char** argv) {
   out.close();
   std::printf("wrote %s\n", csv.c_str());
 
-  // Goals per path: ratios of the sums of minima, and min / median over repetitions of each repetition's ratio.
+  // Goals per path and reuse method: ratios of the sums of minima, and min / median over
+  // repetitions of each repetition's ratio.
   const int stand_begin = frames * 50 / 120, stand_end = stand_begin + frames * 20 / 120;
+  const auto min_of = [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); };
   for (const std::string& path : paths) {
     const auto& rows = res[path];
     std::array<double, methods> sum_min{};
     std::vector<std::array<double, methods>> sum_rep(static_cast<std::size_t>(reps));
-    double min_psnr = 99.0, worst_gap = -1e30, min_ssim = 1.0, stand_ib = 0.0, stand_re = 0.0;
-    int min_psnr_frame = -1, worst_gap_frame = -1;
-    for (int f = 0; f < frames; ++f) {
-      const auto& row = rows[std::size_t(f)];
-      for (int m = 0; m < methods; ++m) {
-        sum_min[std::size_t(m)] += *std::min_element(row[std::size_t(m)].seconds.begin(), row[std::size_t(m)].seconds.end());
-        for (int rep = 0; rep < reps; ++rep) sum_rep[std::size_t(rep)][std::size_t(m)] += row[std::size_t(m)].seconds[std::size_t(rep)];
+    for (const auto& row : rows)
+      for (std::size_t m = 0; m < methods; ++m) {
+        sum_min[m] += min_of(row[m].seconds);
+        for (std::size_t rep = 0; rep < sum_rep.size(); ++rep) sum_rep[rep][m] += row[m].seconds[rep];
       }
-      const frame_result& ib = row[2].r;
-      const frame_result& re = row[3].r;
-      if (re.psnr < min_psnr) min_psnr = re.psnr, min_psnr_frame = f;
-      if (ib.psnr - re.psnr > worst_gap) worst_gap = ib.psnr - re.psnr, worst_gap_frame = f;
-      min_ssim = std::min(min_ssim, re.ssim);
-      if (path == "orbit" && f > stand_begin && f < stand_end) {
-        stand_ib += *std::min_element(row[2].seconds.begin(), row[2].seconds.end());
-        stand_re += *std::min_element(row[3].seconds.begin(), row[3].seconds.end());
+    std::printf("%s: sums of minima over %d frames:", path.c_str(), frames);
+    for (std::size_t m = 0; m < methods; ++m) std::printf(" %s %.3f s%s", method_names[m], sum_min[m], m + 1 < methods ? "," : "\n");
+    for (std::size_t rm : {std::size_t{3}, std::size_t{4}}) {
+      const char* name = method_names[rm];
+      for (std::size_t num : {std::size_t{2}, std::size_t{0}, std::size_t{1}}) {
+        std::vector<double> v;
+        for (const auto& sr : sum_rep) v.push_back(sr[num] / sr[rm]);
+        std::printf("%s goal: %s vs %s x%.2f (sums of minima; per repetition min x%.2f, median x%.2f)%s\n", path.c_str(), name,
+                    method_names[num], sum_min[num] / sum_min[rm], min_of(v), median(v),
+                    num == 2 ? " (>= 2)" : num == 0 ? " (>= 50)" : " (named beside it)");
       }
+      double min_psnr = 99.0, worst_gap = -1e30, min_ssim = 1.0, stand_ib = 0.0, stand_re = 0.0;
+      int min_psnr_frame = -1, worst_gap_frame = -1, below = 0;
+      for (int f = 0; f < frames; ++f) {
+        const auto& row = rows[std::size_t(f)];
+        const frame_result& ib = row[2].r;
+        const frame_result& re = row[rm].r;
+        if (re.psnr < min_psnr) min_psnr = re.psnr, min_psnr_frame = f;
+        if (ib.psnr - re.psnr > worst_gap) worst_gap = ib.psnr - re.psnr, worst_gap_frame = f;
+        below += re.psnr < 40.0 || ib.psnr - re.psnr > 0.5 || re.ssim < 0.98 ? 1 : 0;
+        min_ssim = std::min(min_ssim, re.ssim);
+        if (path == "orbit" && f > stand_begin && f < stand_end) stand_ib += min_of(row[2].seconds), stand_re += min_of(row[rm].seconds);
+      }
+      std::printf("%s goal: %s lowest PSNR %.2f dB at frame %d (>= 40); largest drop below ibuffer %.2f dB at frame %d (<= 0.5); "
+                  "lowest SSIM %.5f (>= 0.98); frames missing one of these %d\n", path.c_str(), name, min_psnr, min_psnr_frame,
+                  worst_gap, worst_gap_frame, min_ssim, below);
+      if (path == "orbit")
+        std::printf("orbit goal: %s standing frames %d-%d x%.2f the per-frame I-Buffer (>= 10)\n", name, stand_begin + 1,
+                    stand_end - 1, stand_ib / stand_re);
     }
-    const auto ratios = [&](int num) {
-      std::vector<double> v;
-      for (const auto& sr : sum_rep) v.push_back(sr[std::size_t(num)] / sr[3]);
-      return v;
-    };
-    std::printf("%s: sums of minima over %d frames: per_pixel %.3f s, per_pixel_packets %.3f s, ibuffer %.3f s, ibuffer_reuse %.3f s\n",
-                path.c_str(), frames, sum_min[0], sum_min[1], sum_min[2], sum_min[3]);
-    for (int num : {2, 0, 1}) {
-      const auto v = ratios(num);
-      std::printf("%s goal: reuse vs %s x%.2f (sums of minima; per repetition min x%.2f, median x%.2f)%s\n", path.c_str(),
-                  method_names[num], sum_min[std::size_t(num)] / sum_min[3], *std::min_element(v.begin(), v.end()), median(v),
-                  num == 2 ? " (>= 2)" : num == 0 ? " (>= 50)" : " (named beside it)");
-    }
-    std::printf("%s goal: lowest reuse PSNR %.2f dB at frame %d (>= 40); largest drop below ibuffer %.2f dB at frame %d (<= 0.5); "
-                "lowest SSIM %.5f (>= 0.98)\n", path.c_str(), min_psnr, min_psnr_frame, worst_gap, worst_gap_frame, min_ssim);
-    if (path == "orbit")
-      std::printf("orbit goal: standing frames %d-%d: reuse x%.2f the per-frame I-Buffer (>= 10)\n", stand_begin + 1, stand_end - 1,
-                  stand_ib / stand_re);
   }
 
   // The breakdown: one more run of each path with the sources under the timing wrapper.
@@ -588,19 +586,22 @@ int pareto_upsample_path(int argc, char** argv) {
     std::array<double, methods> total{};
     auto up_plain = h.upsampler_for(s);
     auto up_reuse = h.upsampler_for(rs, true);
+    auto up_terms = h.upsampler_for(rs, true);
     auto reuse = reuse_t::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
+    auto reuse_terms = infolerp::frame_reuse<sample>::create(std::uint32_t(width), std::uint32_t(height), reuse_options);
     std::vector<glm::vec3> tmp;
     for (int f = 0; f < frames; ++f) {
       const auto v = h.view_at(path, float(f));
       total[0] += h.per_pixel(v, tmp, false, &b[0]).seconds;
       total[2] += h.ibuffer(v, s, up_plain, tmp, &b[2]).seconds;
       total[3] += h.reuse(v, rs, up_reuse, *reuse, tmp, &b[3]).seconds;
+      total[4] += h.reuse(v, rs, up_terms, *reuse_terms, tmp, &b[4]).seconds;
     }
-    for (int m : {0, 2, 3}) {
+    for (int m : {0, 2, 3, 4}) {
       const auto t = b[std::size_t(m)].total();
       const double threads_n = double(threads > 0 ? threads : omp_get_max_threads());
       const double cpu = total[std::size_t(m)] * threads_n;  // wall times threads: the CPU the parts are shares of
-      std::printf("%s breakdown %-13s wall %.3f s: visibility %.1f%%, evaluation %.1f%%, interpolation %.1f%%, shading %.1f%%, "
+      std::printf("%s breakdown %-19s wall %.3f s: visibility %.1f%%, evaluation %.1f%%, interpolation %.1f%%, shading %.1f%%, "
                   "rest (upsampler's tests and stores, reprojection, idle threads) %.1f%%\n", path.c_str(), method_names[m],
                   total[std::size_t(m)], 100.0 * t[0] / cpu, 100.0 * t[1] / cpu, 100.0 * t[2] / cpu, 100.0 * t[3] / cpu,
                   100.0 * (cpu - t[0] - t[1] - t[2] - t[3]) / cpu);

@@ -13,8 +13,9 @@
 // its expensive terms; else the source evaluates from the probe. Position, normal and texcoords
 // are the probe's, new every frame. A kept sample at the probe's very position (bit for bit)
 // is taken whole.
-// Colour (only with a Pixel type and a source with view_dependence(s)): a pixel whose sample
-// was not evaluated this frame takes the bilinear blend of the kept colours around its
+// Colour (only with a Pixel type, a source with view_dependence(s) and records with ==): a
+// pixel whose sample was not evaluated this frame takes its kept colour when its record equals
+// the kept one there (a camera standing still), or the bilinear blend of the kept colours around its
 // reprojection when they pass the same test against its sample, differ by at most
 // colour_tolerance per channel (so a blend is that close to each of them: texture detail is
 // shaded, not blurred), and the view direction at it has turned, summed since the colour was
@@ -27,11 +28,12 @@
 // interpolated is given the oldest age among the samples it asked for in its coarsest cell
 // (2^(passes-1) pixels, the cell all its sources lie in); a colour shaded from aged terms has
 // their age. Sources of age max_age or more never serve, so no served value is more than max_age
-// resamplings from an evaluation. Besides, each reusable pixel (aged, or resampled now) is
-// refreshed once in every refresh_period frames at a phase hashed from its position, so a moving
-// camera spreads its refreshes and a camera standing still converges to the fresh frame bit for
-// bit within refresh_period frames; from then on a frame with the same view and nothing
-// invalidated copies the kept colours (stats().repeated).
+// resamplings from an evaluation. Besides, while the camera moves each reusable pixel (aged, or
+// resampled now) is refreshed once in every refresh_period frames at a phase hashed from its
+// position, spreading the refreshes; when it stands still (the same view twice) every aged value
+// is refreshed at once, so the frame is the fresh frame bit for bit, and from then on a frame
+// with the same view and nothing invalidated copies the kept colours (stats().repeated).
+// refresh_period 0 turns refreshes off (ages still bound the resampling).
 // invalidate(): the next frame is a fresh one, bit for bit (scene, lights or ids changed);
 // invalidate_if(pred): an object changed (pred names the kept samples it touches).
 // Preconditions: the source's camera is render()'s pinhole_frame; sample_type has a world
@@ -60,9 +62,10 @@ namespace infolerp {
 
 struct frame_reuse_options {
   float depth_tolerance = 0.02f;     // a kept sample serves when its view depth is within this share of the probe's
-  std::uint32_t refresh_period = 4;  // each reusable pixel is evaluated (shaded) anew once in this many frames (0: never)
+  std::uint32_t refresh_period = 4;  // moving: each reusable pixel is evaluated (shaded) anew once in this many frames (0: never)
   std::uint8_t max_age = 8;          // kept values resampled this many times never serve (1..254)
-  float colour_tolerance = 1.0f / 255.0f;  // kept colours blend only where they differ by at most this (per channel)
+  float colour_tolerance = 0.0f;     // kept colours blend only where they differ by at most this per channel (0: a
+                                     // colour is kept only where the camera stands still; see benchmarks/NOTES.md)
 };
 
 // What the last render() did. Counts are of pixels; evaluated includes the cropped border
@@ -157,7 +160,8 @@ class reusing_source {
  public:
   using sample_type = typename Source::sample_type;
   using S = sample_type;
-  static constexpr bool keeps_colour = !std::is_void_v<Pixel> && detail::member_view_dependence<Source>;
+  static constexpr bool keeps_colour =
+      !std::is_void_v<Pixel> && detail::member_view_dependence<Source> && std::equality_comparable<sample_type>;
   using colour = std::conditional_t<std::is_void_v<Pixel>, char, Pixel>;
 
   struct history {
@@ -169,6 +173,7 @@ class reusing_source {
     std::span<const float> colour_angle;      // radians the view turned since each colour was shaded
     const pinhole_frame* view = nullptr;      // previous frame's camera; null: no history
     const pinhole_frame* now = nullptr;       // this frame's camera
+    bool same_view = false;                   // the camera stands still: kept colours serve whole or not at all
     frame_reuse_options options;
     std::uint32_t frame = 0;
   };
@@ -214,7 +219,7 @@ class reusing_source {
 
   pixel_type_of<Source> shade(const S& s, std::uint32_t x, std::uint32_t y) const {
     if constexpr (keeps_colour) {
-      if (!h_.colours.empty() && !is_background(s)) {
+      if (!h_.colours.empty() && (h_.same_view || h_.options.colour_tolerance > 0.0f) && !is_background(s)) {
         const std::size_t i = std::size_t{y} * width_ + x;
         if (o_.marks[i] < std::uint8_t(reuse_mark::evaluated)) {
           if (auto c = kept_colour(s, x, y, i)) return pixel_type_of<Source>(*c);
@@ -281,9 +286,11 @@ class reusing_source {
     mark(x, y, reuse_mark::reused, age);
     return std::move(s);
   }
+  // A camera standing still refreshes every aged value at once (the moment to correct drift);
+  // a moving one each pixel once in refresh_period frames.
   bool refresh_now(std::uint32_t x, std::uint32_t y) const {
     const std::uint32_t k = h_.options.refresh_period;
-    return k > 0 && (detail::reuse_hash(x, y) + h_.frame) % k == 0;
+    return k > 0 && (h_.same_view || (detail::reuse_hash(x, y) + h_.frame) % k == 0);
   }
   static std::uint8_t oldest(std::span<const std::uint8_t> a, const detail::reprojection& r) {
     return std::max(std::max(a[r.idx[0]], a[r.idx[1]]), std::max(a[r.idx[2]], a[r.idx[3]]));
@@ -329,7 +336,10 @@ class reusing_source {
     detail::reprojection r;
     if (!detail::reproject(*h_.view, h_.view->project(s.position), r)) return std::nullopt;
     const double z = depth(s);
-    const bool whole = s.position == h_.samples[r.nearest].position;
+    // Taken whole only for the very record it was shaded from: a sample the upsampler
+    // interpolated anew from changed sources is shaded again.
+    const bool whole = s == h_.samples[r.nearest];
+    if (h_.same_view && !whole) return std::nullopt;  // the record changed where the view did not: shade it
     if (whole ? !serves_one(s, r.nearest, z, h_.colour_age) : !serves(s, r, z, h_.colour_age)) return std::nullopt;
     const std::uint8_t age = whole ? h_.colour_age[r.nearest] : std::uint8_t(oldest(h_.colour_age, r) + 1);
     if ((age > 0 || !whole || h_.colour_angle[r.nearest] > 0.0f) && refresh_now(x, y)) return std::nullopt;
@@ -458,8 +468,9 @@ class frame_reuse {
     std::fill(new_age_.begin(), new_age_.end(), detail::not_asked);
     const bool colour_history = kept_ && colours_kept_ && wrapped_t::keeps_colour;
     typename wrapped_t::history hist{history_, valid_, age_, colours_, colour_age_, colour_angle_,
-                                     kept_ ? &view_ : nullptr, &view, options_, frame_};
+                                     kept_ ? &view_ : nullptr, &view, false, options_, frame_};
     if (!colour_history) hist.colours = {};
+    hist.same_view = kept_ && same_view(view, view_);
     const wrapped_t wrapped(src, hist, {marks_, new_age_, new_colour_age_, new_colour_angle_}, w, h);
     if (status s = up.render(wrapped, out, exec); !s) return s;
     if (status s = up.swap_ibuffer(history_); !s) return s;

@@ -87,6 +87,8 @@ struct surface_sample {
   float inv_depth = 1.0f;  // 1 / view-space depth (> 0) for perspective-correct weights; all 1: screen-linear
 
   [[nodiscard]] constexpr bool background() const noexcept { return cluster == invalid_id; }
+  // Member by member (frame_reuse.hpp keeps a colour whole only for an equal record).
+  friend constexpr bool operator==(const surface_sample&, const surface_sample&) noexcept = default;
 };
 
 // Same cluster (background counts as its own cluster) and, when compiled in, same light bits.
