@@ -283,6 +283,7 @@ struct analytic_source {
   infolerp::pinhole_frame view{};
   bool affine = false;        // the plane's term is affine_term(position) instead of the soft shadow
   float sphere_albedo = 1.0f;  // the sphere's material: its shaded value is this times its term
+  float sphere_term = 1.0f;    // the sphere's occlusion term
 
   static float affine_term(glm::vec3 p) { return 0.5f + 0.11f * p.x - 0.07f * p.y; }
 
@@ -311,7 +312,7 @@ struct analytic_source {
   }
   asample evaluate(std::uint32_t x, std::uint32_t y) const {
     asample s = probe(x, y);
-    if (!s.background()) s.occlusion[0] = s.cluster == 1 ? 1.0f : affine ? affine_term(s.position) : sc->sun_visible(s.position);
+    if (!s.background()) s.occlusion[0] = s.cluster == 1 ? sphere_term : affine ? affine_term(s.position) : sc->sun_visible(s.position);
     return s;
   }
   float shade(const asample& s, std::uint32_t, std::uint32_t) const {
@@ -447,10 +448,11 @@ TEST_CASE("frame reuse: pixels disoccluded by a sideways step are never filled f
   REQUIRE((up && fresh_up && reuse));
   std::vector<float> out(std::size_t{W} * H), fresh_out(out.size());
   const glm::vec3 before_eye = cam.eye;
-  REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+  // The sphere's term 0: a plane pixel (sun-lit here, term 1) completed from it would show 0.
+  REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame(), false, 1.0f, 0.0f}, cam.frame(), std::span<float>(out)));
   cam.eye.x += 0.25f;
   cam.target.x += 0.25f;
-  const analytic_source src{&sc, cam.frame()};
+  const analytic_source src{&sc, cam.frame(), false, 1.0f, 0.0f};
   REQUIRE(reuse->render(*up, src, cam.frame(), std::span<float>(out)));
   REQUIRE(fresh_up->render(src, std::span<float>(fresh_out)));
   const auto hidden_before = [&](glm::vec3 p) {  // the segment from the previous eye to p meets the sphere
@@ -471,7 +473,7 @@ TEST_CASE("frame reuse: pixels disoccluded by a sideways step are never filled f
       worst = std::max(worst, std::abs(out[i] - fresh_out[i]));
     }
   REQUIRE(disoccluded > 20);
-  CHECK(worst < 0.05f);  // the sphere shades 1, the plane beside it (in its shadow) far less
+  CHECK(worst < 0.05f);
   CHECK(reuse->stats().reused > 0);
 }
 
@@ -540,4 +542,27 @@ TEST_CASE("frame reuse: 500 slow frames then 50 standing end on the fresh frame"
   CHECK(worst_moving >= 40.0);
   CHECK(reuse->stats().repeated);
   CHECK(same_frame(out, fresh(moved(0.002f * 499.0f))));
+}
+
+TEST_CASE("frame reuse: no served term is more than max_age resamplings from an evaluation", "[upsample][frame_reuse]") {
+  // max_age 1, no refreshes, a camera moving every frame: frame 1 serves terms resampled once
+  // (age 1), and the samples the upsampler interpolates from them carry that age too, so frame
+  // 2 can serve almost nothing; frame 3, from frame 2's evaluations, serves again.
+  const sphere_scene sc{};
+  infolerp::pinhole_camera cam{.eye = {0.0f, -6.0f, 4.0f}, .target = {0.5f, 0.5f, 0.0f}, .up = {0.0f, 0.0f, 1.0f},
+                               .vertical_fov_degrees = 50.0f, .width = W, .height = H};
+  auto up = infolerp::upsampler<asample>::create(W, H, {.passes = 3, .max_passes = 3, .keep_ibuffer = true});
+  auto reuse = infolerp::frame_reuse<asample>::create(W, H, {.refresh_period = 0, .max_age = 1});
+  REQUIRE((up && reuse));
+  std::vector<float> out(std::size_t{W} * H);
+  std::array<std::size_t, 4> reused{};
+  for (std::size_t f = 0; f < reused.size(); ++f) {
+    REQUIRE(reuse->render(*up, analytic_source{&sc, cam.frame()}, cam.frame(), std::span<float>(out)));
+    reused[f] = reuse->stats().reused;
+    cam.eye.x += 0.13f;  // a few pixels: the kept samples around a reprojection are mostly interpolated ones
+  }
+  CHECK(reused[0] == 0);
+  CHECK(reused[1] > 300);
+  CHECK(reused[2] * 20 < reused[1]);
+  CHECK(reused[3] > 300);
 }
