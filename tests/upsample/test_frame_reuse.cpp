@@ -1,9 +1,12 @@
 // Reuse across frames (upsample/frame_reuse.hpp): on the demo scene through Embree with the
 // ready source, a fresh frame after invalidate(), a camera standing still and a camera cut
 // against the upsampler without reuse in the same run, bit for bit; every executor alike; a
-// small move close to the fresh frame; bad input named. On an analytic scene (a sphere's soft
-// shadow on a plane), a moved sphere invalidated by the user shows no stale shadow, and the
-// same without invalidation does (the check can fail).
+// small move close to the fresh frame; 500 slow frames and 50 standing ending on the fresh frame;
+// bad input named. On analytic scenes (a plane, a sphere and its soft shadow under a sun):
+// reused terms against the analytic values after a sub-pixel move, disoccluded pixels against
+// the from-scratch frame, a moved object, a moved light and a changed material with and without
+// invalidate_if against the from-scratch frame (the checks without it show the stale values),
+// the age bound, and warm frames allocating nothing.
 #include <catch2/catch.hpp>
 
 #include <atomic>
