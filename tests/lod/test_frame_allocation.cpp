@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 #include "infolerp/lod/cluster_local_indices.hpp"
 #include "infolerp/lod/view_dependent_lod.hpp"
-#include "support/allocation_counter.hpp"
+#include "support/counting_new.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"
 

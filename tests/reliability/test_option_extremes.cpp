@@ -32,7 +32,7 @@
 #include "infolerp/upsample/ray_cast_source.hpp"
 #include "infolerp/upsample/upsampler.hpp"
 #include "reliability/reliability_support.hpp"
-#include "support/allocation_counter.hpp"
+#include "support/counting_new.hpp"
 #include "support/brute_force_tracer.hpp"
 #include "support/procedural.hpp"
 #include "support/thread_pool.hpp"

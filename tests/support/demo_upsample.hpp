@@ -229,6 +229,16 @@ struct demo_material {
     in.soft_shadow = s.occlusion[1];
     return shader->shade(in);
   }
+  // Display steps per radian of view turn (frame_reuse.hpp): the sun's Blinn-Phong highlight
+  // (exponent 48) on a specular material where the sun is seen; the sky and everything else do
+  // not change with the view (0; image textures at mip level 0, shader_options::pixel_angle 0).
+  float view_dependence(const demo_sample& s) const {
+    if (s.background()) return std::numeric_limits<float>::infinity();
+    const material& mat = shader->scene().objects[clusters->geometry_of[s.cluster]].mat;
+    if (mat.specular == 0.0f || (s.lights & sun_light_bit) == 0) return 0.0f;
+    const glm::vec3 r = shader->scene().sun.radiance;
+    return 255.0f * 48.0f * mat.specular * std::max(r.x, std::max(r.y, r.z));
+  }
 };
 template <probe_mode Probes = probe_mode::none>
 using demo_ray_cast_source = ray_cast_source<embree_scene, demo_camera, demo_geometry, demo_material, Probes>;

@@ -16,7 +16,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec4.hpp>
 #include "infolerp/upsample/upsampler.hpp"
-#include "support/allocation_counter.hpp"
+#include "support/counting_new.hpp"
 #include "support/thread_pool.hpp"
 
 namespace {

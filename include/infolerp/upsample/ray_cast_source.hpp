@@ -15,7 +15,8 @@
 //             infolerp::mesh; normals and texcoords used when it has them)
 //   Material  Pixel operator()(const surface_sample<2>& s, const V& view) const: the colour of
 //             a record; s.normal is unit; view() returns the pixel's unit primary direction
-//             (computed only when called: for the sky, for highlights)
+//             (computed only when called: for the sky, for highlights); optionally
+//             float view_dependence(const surface_sample<2>& s) const (sample_source.hpp)
 // Probes (sample_source.hpp, optional, a compile-time choice): probe_mode::primary probes trace
 // the primary ray and the hard-shadow rays; probe_mode::refine probes trace the primary ray only
 // and refine_probe adds the hard-shadow rays where the upsampler needs them. agree() compares
@@ -30,6 +31,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -155,6 +157,16 @@ class ray_cast_source {
 
   // §4: full evaluation of pixel (x, y).
   sample_type evaluate(std::uint32_t x, std::uint32_t y) const { return trace(x, y, true, true); }
+  // The same from the pixel's probe (refined in probe_mode::refine): its hard-shadow bits are
+  // kept, not traced again. The primary ray is traced again for the geometric normal the
+  // secondary rays leave from, which the record does not keep (one ray of the evaluation's
+  // 1 + lights + soft-shadow points + AO rays).
+  sample_type evaluate(const sample_type& probe, std::uint32_t x, std::uint32_t y) const requires(Probes != probe_mode::none) {
+    if (probe.background()) return probe;
+    sample_type s = trace(x, y, false, true);
+    s.lights = probe.lights;
+    return s;
+  }
 
   // The record's colour: the material callback with a unit normal. Interpolated normals are
   // renormalised in every probe mode: with probes only where sources differ, whole
@@ -191,6 +203,13 @@ class ray_cast_source {
   sample_type refine_probe(const sample_type&, std::uint32_t x, std::uint32_t y) const
     requires(Probes == probe_mode::refine) {
     return trace(x, y, true, false);
+  }
+  // The material's view_dependence(s) when it has one (frame_reuse.hpp: a colour that the view
+  // cannot change by a display step is carried across frames); absent otherwise.
+  float view_dependence(const sample_type& s) const requires requires(const Material& m) {
+    { m.view_dependence(s) } -> std::convertible_to<float>;
+  } {
+    return material_.view_dependence(s);
   }
   bool agree(const sample_type& a, const sample_type& b) const { return occlusion_within(a, b, options_.tolerance); }
   bool smooth(const sample_type& a, const sample_type& b) const { return normals_within(a, b, smooth_cos_); }

@@ -38,6 +38,15 @@
 //   bool agree(a, b) const    beyond the paper: a new sample is evaluated unless every pair of its
 //        sources agrees (e.g. occlusion_within below); need not be transitive, and a source that
 //        always agrees gives exactly the frame of one without it
+//   sample_type evaluate(const sample_type& probe, uint32_t x, uint32_t y) const   with probes: the
+//        full evaluation of pixel (x, y) from its probe (refined first when the source refines),
+//        the same record as evaluate(x, y) without tracing again what the probe traced
+// For reuse across frames (frame_reuse.hpp), on the record (member or ADL) and on the source:
+//   sample_type interpolate(probe, a, b, c, d, std::array<float, 4> w)   the probe completed with
+//        the expensive terms of a, b, c, d at bilinear weights w (sum 1)
+//   float view_dependence(const sample_type& s) const    how fast s's colour changes with the view:
+//        display steps (1/255 of a channel) per radian the view direction at s turns; 0 for a
+//        diffuse material. A source without it has every colour shaded anew each frame
 // smooth() and agree() are symmetric, thread-safe and deterministic like compatible().
 #include <array>
 #include <cmath>
@@ -78,6 +87,8 @@ struct surface_sample {
   float inv_depth = 1.0f;  // 1 / view-space depth (> 0) for perspective-correct weights; all 1: screen-linear
 
   [[nodiscard]] constexpr bool background() const noexcept { return cluster == invalid_id; }
+  // Member by member (frame_reuse.hpp keeps a colour whole only for an equal record).
+  friend constexpr bool operator==(const surface_sample&, const surface_sample&) noexcept = default;
 };
 
 // Same cluster (background counts as its own cluster) and, when compiled in, same light bits.
@@ -207,6 +218,24 @@ template <std::size_t K, bool L>
   return s;
 }
 
+// With a probe, for reuse across frames: the primary-hit part from the probe, light bits from
+// a, occlusion terms from a, b, c, d at bilinear weights w (sum 1; a weight-0 source is read
+// only for its bits), made perspective-correct by their inv_depth in the view they were taken
+// in (w_i·inv_depth_i normalised), so that a term affine on a plane in the world is reproduced
+// exactly at any sub-pixel position. O(K), no allocation.
+template <std::size_t K, bool L>
+[[nodiscard]] constexpr surface_sample<K, L> interpolate(const surface_sample<K, L>& probe, const surface_sample<K, L>& a,
+                                                         const surface_sample<K, L>& b, const surface_sample<K, L>& c,
+                                                         const surface_sample<K, L>& d, const std::array<float, 4>& w) noexcept {
+  const float wa = w[0] * a.inv_depth, wb = w[1] * b.inv_depth, wc = w[2] * c.inv_depth, wd = w[3] * d.inv_depth;
+  const float r = 1.0f / ((wa + wb) + (wc + wd));
+  surface_sample<K, L> s = detail::probe_part(probe);
+  s.lights = a.lights;
+  for (std::size_t i = 0; i < K; ++i)
+    s.occlusion[i] = ((wa * a.occlusion[i] + wb * b.occlusion[i]) + (wc * c.occlusion[i] + wd * d.occlusion[i])) * r;
+  return s;
+}
+
 namespace detail {
 template <class S>
 using sample_of = typename S::sample_type;
@@ -245,6 +274,22 @@ concept member_agree = requires(const S& s, const sample_of<S>& a) {
 template <class S>
 concept member_smooth = requires(const S& s, const sample_of<S>& a) {
   { s.smooth(a, a) } -> std::convertible_to<bool>;
+};
+template <class S>
+concept member_probe_evaluate = requires(const S& s, const sample_of<S>& a, std::uint32_t x) {
+  { s.evaluate(a, x, x) } -> std::convertible_to<sample_of<S>>;
+};
+template <class S>
+concept member_weighted_interpolate = requires(const S& s, const sample_of<S>& a, const std::array<float, 4>& w) {
+  { s.interpolate(a, a, a, a, a, w) } -> std::convertible_to<sample_of<S>>;
+};
+template <class T>
+concept adl_weighted_interpolate = requires(const T& a, const std::array<float, 4>& w) {
+  { interpolate(a, a, a, a, a, w) } -> std::convertible_to<T>;
+};
+template <class S>
+concept member_view_dependence = requires(const S& s, const sample_of<S>& a) {
+  { s.view_dependence(a) } -> std::convertible_to<float>;
 };
 template <class T>
 concept adl_compatible = requires(const T& a) {
@@ -401,6 +446,26 @@ template <class S>
     return s.interpolate(p, a, b, c, d);
   } else {
     return interpolate(p, a, b, c, d);
+  }
+}
+// The full evaluation of pixel (x, y) whose probe p the caller holds (refined when the source
+// refines): from p when the source can, else evaluate(x, y).
+template <class S>
+[[nodiscard]] inline sample_of<S> source_evaluate(const S& s, const sample_of<S>& p, std::uint32_t x, std::uint32_t y) {
+  if constexpr (member_probe_evaluate<S>) {
+    return s.evaluate(p, x, y);
+  } else {
+    return s.evaluate(x, y);
+  }
+}
+template <class S>
+[[nodiscard]] inline sample_of<S> source_interpolate(const S& s, const sample_of<S>& p, const sample_of<S>& a,
+                                                     const sample_of<S>& b, const sample_of<S>& c,
+                                                     const sample_of<S>& d, const std::array<float, 4>& w) {
+  if constexpr (member_weighted_interpolate<S>) {
+    return s.interpolate(p, a, b, c, d, w);
+  } else {
+    return interpolate(p, a, b, c, d, w);
   }
 }
 }  // namespace detail

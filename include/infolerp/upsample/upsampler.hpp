@@ -388,7 +388,8 @@ class upsampler {
   // corners or a diagonal of a centre, whose midpoint it is), so that what the cheap probe
   // leaves out is taken from sources on both sides of it; only where that fails is the probe
   // refined and tested again, now with compatible() and min_sources. Otherwise, or when the
-  // chosen sources do not all agree() pairwise (a source's optional tolerance), evaluated.
+  // chosen sources do not all agree() pairwise (a source's optional tolerance), evaluated: from
+  // the probe (refined first) when the source has evaluate(probe, x, y), so that no ray is traced twice.
   template <class S, class Pixel>
   void probe_row(const S& src, std::uint32_t d, std::uint32_t j, std::span<Pixel> out,
                  std::array<std::size_t, 3>& counts) {
@@ -436,10 +437,12 @@ class upsampler {
     const auto probe_match = [&](const Sample& q, const Sample& s) { return detail::may_complete(src, q, s); };
     const std::uint32_t x = i << d, y = j << d;
     chosen k;
+    [[maybe_unused]] bool refined = false;
     if constexpr (refining_sample_source<S>) {
       k = choose_sources(src, p, r0, r1, i, j, {.single = false, .cross = cross_check, .bracket = true}, probe_match);
       if (k.n == 0) {
         p = src.refine_probe(p, x, y);
+        refined = true;
         const auto full_match = [&](const Sample& q, const Sample& t) { return detail::may_interpolate(src, q, t); };
         k = choose_sources(src, p, r0, r1, i, j, {.single = single, .cross = false, .bracket = false}, full_match);
       }
@@ -448,7 +451,10 @@ class upsampler {
     }
     if (k.n == 0 || !(k.n == 4 ? detail::sources_agree(src, *k.c[0], *k.c[1], *k.c[2], *k.c[3])
                                : detail::sources_agree(src, *k.c[0], *k.c[1]))) {
-      store(src, d, i, j, src.evaluate(x, y), sample_kind::evaluated, out, counts);
+      if constexpr (detail::member_probe_evaluate<S> && refining_sample_source<S>) {
+        if (!refined) p = src.refine_probe(p, x, y);  // evaluate(probe, x, y) takes a refined probe
+      }
+      store(src, d, i, j, detail::source_evaluate(src, p, x, y), sample_kind::evaluated, out, counts);
     } else if (k.n == 4) {
       store(src, d, i, j, detail::source_interpolate(src, p, *k.c[0], *k.c[1], *k.c[2], *k.c[3]),
             sample_kind::interpolated, out, counts);
