@@ -24,8 +24,8 @@
 // saliency: meshopt_simplify 0.18 takes no per-vertex weights.
 //
 // Cut (per camera): cluster c is drawn when err(self) <= τ < err(parent), err(g) = g.error ·
-// focal / (distance from the eye to g's sphere) (view cut; +inf when the eye is inside the
-// sphere; level-0 clusters have self error 0; roots parent error +inf) or err(g) = g.error
+// focal / max(distance from the eye to g's sphere, znear) (view cut; znear 1% of the box
+// diagonal; level-0 clusters have self error 0; roots parent error +inf) or err(g) = g.error
 // (uniform cut, the same for every camera). τ is chosen among the groups' errors by bisection so
 // that the DRAWN count after per-triangle culling is nearest the fraction's triangle count.
 // Culling = the library's own test (lod/hidden_triangles.hpp: hidden_triangle), back faces
@@ -37,8 +37,9 @@
 // CSV (kind=view): kind,mesh,method,fraction,view,triangles,cut_triangles,open_edges,psnr_db,ssim,tau
 //   method dag_view, peer_view (meshopt at dag_view's drawn count), dag_uniform, peer_uniform
 //   (at dag_uniform's); triangles: drawn (after culling); cut_triangles: before culling;
-//   open_edges: edges of the unculled cut not shared by exactly two triangles of opposite
-//   winding (0 on a crack-free cut of a closed mesh). psnr_db, ssim: that camera's 256x256
+//   open_edges: directed edges of the unculled cut (peer rows: meshopt's whole output) that are
+//   repeated or lack their reverse (0 on a closed manifold surface; a crack or a non-manifold
+//   edge counts). psnr_db, ssim: that camera's 256x256
 //   reference-shader image (support/mesh_views.hpp; primary hits and normals from the drawn
 //   triangles, shadow and AO rays against the full mesh, as benchmarks/pareto/lod.cpp's view rows)
 //   against the full mesh's. Cameras: lod.cpp's 8 orbit and 8 close ones.
@@ -246,6 +247,20 @@ cluster_dag build_dag(const indexed_mesh& m, const dag_options& opt) {
         ++d.terminal;
         continue;
       }
+      if (std::getenv("INFOLERP_DAG_CHECK")) {  // the part's border edges must come out unchanged
+        auto border = [](const std::vector<std::uint32_t>& idx, const std::vector<std::uint32_t>& to_global) {
+          std::vector<std::uint64_t> e, b;
+          for (std::size_t i = 0; i < idx.size(); i += 3)
+            for (std::size_t j = 0; j < 3; ++j)
+              e.push_back(std::uint64_t{to_global[idx[i + j]]} << 32 | to_global[idx[i + (j + 1) % 3]]);
+          std::sort(e.begin(), e.end());
+          for (std::uint64_t x : e)
+            if (!std::binary_search(e.begin(), e.end(), (x & 0xffffffffu) << 32 | x >> 32)) b.push_back(x);
+          return b;
+        };
+        const auto bi = border(local, global), bo = border(simplified, global);
+        if (bi != bo) std::printf("# level %zu part of %zu triangles: border %zu edges in, %zu out\n", d.levels, merged, bi.size(), bo.size());
+      }
       bounds b = merge(d, g);
       const double own = static_cast<double>(rel) * static_cast<double>(meshopt_simplifyScale(&pos[0].x, pos.size(), sizeof(glm::vec3)));
       b.error = opt.error_sum ? b.error + own : std::max(b.error, own);
@@ -295,8 +310,10 @@ culler make_culler(const lod_camera& cam, const indexed_mesh& m, std::span<const
   return c;
 }
 
-// err(g) per group for the camera (view) or the groups' errors (uniform).
-void group_errors(const cluster_dag& d, const glm::dvec3& eye, double focal, bool view, std::vector<double>& err) {
+// err(g) per group for the camera (view) or the groups' errors (uniform). The distance is
+// clamped below at znear (as clusterlod's demo clamps it at the near plane), which keeps the
+// order of the errors, so that a group whose sphere holds the eye can still be coarsened.
+void group_errors(const cluster_dag& d, const glm::dvec3& eye, double focal, double znear, bool view, std::vector<double>& err) {
   err.resize(d.group.size());
   for (std::size_t g = 0; g < d.group.size(); ++g) {
     const bounds& b = d.group[g];
@@ -304,8 +321,7 @@ void group_errors(const cluster_dag& d, const glm::dvec3& eye, double focal, boo
       err[g] = b.error;
       continue;
     }
-    const double dist = glm::length(b.center - eye) - b.radius;
-    err[g] = dist <= 0.0 ? inf : b.error * focal / dist;
+    err[g] = b.error * focal / std::max(glm::length(b.center - eye) - b.radius, znear);
   }
 }
 
@@ -402,7 +418,7 @@ lod_camera to_lod_camera(const support::camera& c, std::uint32_t size) {
 // meshopt_simplify of the whole mesh whose culled output draws the count nearest `goal`
 // (bisection on the target, interpolation steps alternating with halvings); out: the drawn triangles.
 std::size_t peer_at(const indexed_mesh& m, std::span<const std::uint32_t> all, const culler& cl, std::size_t goal,
-                    std::vector<std::uint32_t>& out) {
+                    std::vector<std::uint32_t>& out, std::vector<std::uint32_t>* whole = nullptr) {
   const std::size_t nt = m.triangle_count();
   std::vector<std::uint32_t> simp(all.size());
   auto drawn = [&](std::size_t k, std::vector<std::uint32_t>* keep) {
@@ -410,6 +426,7 @@ std::size_t peer_at(const indexed_mesh& m, std::span<const std::uint32_t> all, c
                                            3 * k, std::numeric_limits<float>::max(), 0, nullptr);
     std::size_t c = 0;
     if (keep) keep->clear();
+    if (keep && whole) whole->assign(simp.begin(), simp.begin() + static_cast<long>(n));
     for (std::size_t t = 0; t < n / 3; ++t)
       if (!cl.hidden(simp.data() + 3 * t)) {
         ++c;
@@ -465,7 +482,8 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
     full.push_back(std::move((*img)[0]));
   }
   const auto size = static_cast<std::uint32_t>(with_full.width);
-  std::vector<std::uint32_t> out(d.indices.size()), whole, peer;
+  const double znear = 0.01 * mesh_bounds(m).diagonal();
+  std::vector<std::uint32_t> out(d.indices.size()), whole, peer, peer_whole;
   std::vector<double> err, cand;
   for (double f : {0.10, 0.05, 0.01}) {
     if (g_fraction > 0.0 && std::abs(f - g_fraction) > 1e-9) continue;
@@ -479,11 +497,12 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
       const std::vector<std::uint32_t> visible = visible_counts(d, cl);
       double psnr[4] = {0, 0, 0, 0};
       for (int uniform = 0; uniform < 2; ++uniform) {
-        group_errors(d, cam.position, focal, uniform == 0, err);
+        group_errors(d, cam.position, focal, znear, uniform == 0, err);
         const double tau = bisect_tau(d, err, visible, target, cand);
         const std::size_t n = write_cut(d, err, tau, cl, out.data(), &whole);
         const std::size_t open = open_edges(whole);
-        const std::size_t pn = peer_at(m, all, cl, n, peer);
+        const std::size_t pn = peer_at(m, all, cl, n, peer, &peer_whole);
+        const std::size_t peer_open = open_edges(peer_whole);
         for (int peer_side = 0; peer_side < 2; ++peer_side) {
           const std::span<const std::uint32_t> idx = peer_side ? std::span<const std::uint32_t>(peer) : std::span<const std::uint32_t>(out.data(), 3 * n);
           auto img = support::render_mesh_views(device, m.positions, idx, std::span<const support::camera>(&cams[v], 1), with_full);
@@ -494,7 +513,7 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
           static const char* names[] = {"dag_view", "peer_view", "dag_uniform", "peer_uniform"};
           for (std::FILE* o : {csv, stdout})
             std::fprintf(o, "view,%s,%s,%.2f,%s,%zu,%zu,%zu,%.4f,%.6f,%.6g\n", name.c_str(), names[2 * uniform + peer_side], f, view.c_str(),
-                         peer_side ? pn : n, peer_side ? pn : whole.size() / 3, peer_side ? 0 : open, sim->psnr, sim->ssim,
+                         peer_side ? pn : n, peer_side ? pn : whole.size() / 3, peer_side ? peer_open : open, sim->psnr, sim->ssim,
                          peer_side ? 0.0 : tau);
           std::fflush(csv);
         }
@@ -516,20 +535,20 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
     const lod_camera cam = to_lod_camera(cams[v], size);
     const double focal = 0.5 * static_cast<double>(size) / std::tan(0.5 * cam.vertical_fov);
     const culler cl = make_culler(cam, m, all, closed);
-    group_errors(d, cam.position, focal, true, err);
+    group_errors(d, cam.position, focal, znear, true, err);
     const double tau = bisect_tau(d, err, visible_counts(d, cl), target, cand);
     std::vector<double> cut_s, exact_s, cp_s;
     std::size_t n = 0;
     for (int r = 0; r < g_reps; ++r) {
       for (int warm = 0; warm < 2; ++warm) {
         t0 = clk::now();
-        group_errors(d, cam.position, focal, true, err);
+        group_errors(d, cam.position, focal, znear, true, err);
         n = write_cut(d, err, tau, cl, out.data(), nullptr);
         if (warm) cut_s.push_back(seconds_since(t0));
       }
       for (int warm = 0; warm < 2; ++warm) {
         t0 = clk::now();
-        group_errors(d, cam.position, focal, true, err);
+        group_errors(d, cam.position, focal, znear, true, err);
         const double tt = bisect_tau(d, err, visible_counts(d, cl), target, cand);
         n = write_cut(d, err, tt, cl, out.data(), nullptr);
         if (warm) exact_s.push_back(seconds_since(t0));
