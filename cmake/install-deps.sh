@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(cmake make g++ clang libclang-rt-14-dev libglm-dev catch2 libembree-dev libbenchmark-dev libstb-dev
-          libassimp-dev gnuplot-nox libmeshoptimizer-dev libtbb-dev openmpi-bin libopenmpi-dev)
+          libassimp-dev gnuplot-nox libmeshoptimizer-dev libmetis-dev libtbb-dev openmpi-bin libopenmpi-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -11,9 +11,9 @@ int main(int argc, char** argv) {
   };
   const sub subs[] = {{"refine", &pareto_refine}, {"upsample", &pareto_upsample}, {"walk", &pareto_walk}, {"lod", &pareto_lod},
                       {"visibility", &pareto_visibility}, {"saliency", &pareto_saliency},
-                      {"pipeline", &pareto_pipeline}};
+                      {"pipeline", &pareto_pipeline}, {"lod_dag", &pareto_lod_dag}};
   for (const sub& s : subs)
     if (argc >= 2 && std::strcmp(argv[1], s.name) == 0 && s.fn != nullptr) return s.fn(argc - 1, argv + 1);
-  std::fprintf(stderr, "usage: infolerp_pareto refine|upsample|walk|lod|visibility|saliency|pipeline [options]\n");
+  std::fprintf(stderr, "usage: infolerp_pareto refine|upsample|walk|lod|visibility|saliency|pipeline|lod_dag [options]\n");
   return 2;
 }

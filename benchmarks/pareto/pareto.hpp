@@ -17,6 +17,7 @@
 [[gnu::weak]] int pareto_visibility(int argc, char** argv);
 [[gnu::weak]] int pareto_saliency(int argc, char** argv);
 [[gnu::weak]] int pareto_pipeline(int argc, char** argv);
+[[gnu::weak]] int pareto_lod_dag(int argc, char** argv);  // reference cluster DAG (meshoptimizer + METIS)
 
 // PSNR in dB of image a against reference b on linear colours clamped to [0, 1] (99 when equal),
 // as the refinement harnesses measure it.
