@@ -128,8 +128,8 @@ elseif(MODE STREQUAL "run")
      OR NOT out MATCHES "\ninfolerp +5% +[0-9]+ ")
     message(FATAL_ERROR "the demo printed no LOD table:\n${out}")
   endif()
-  # lod.png: 3 x 2 panels of 65 pixels; lod_orbit.png: 6 cameras x 2 rows (PNG header: width, height).
-  foreach(png_size IN ITEMS "lod.png:000000c300000082" "lod_orbit.png:0000018600000082")
+  # lod.png: 3 x 3 panels of 65 pixels; lod_orbit.png: 6 cameras x 2 rows (PNG header: width, height).
+  foreach(png_size IN ITEMS "lod.png:000000c3000000c3" "lod_orbit.png:0000018600000082")
     string(REPLACE ":" ";" png_size "${png_size}")
     list(GET png_size 0 f)
     list(GET png_size 1 expected)

@@ -109,6 +109,7 @@ inline status lod_frame(view_dependent_lod& lod, const contraction_hierarchy& h,
 inline bool finish_panel(demo_context& ctx, const support::embree_device& device, const indexed_mesh& m,
                          const std::vector<double>& saliency, const support::mesh_view_options& view,
                          lod_panel& p, const support::image* full) {
+  if (p.indices.empty()) return true;  // nothing drawn (a mesh of a few triangles at 5%): the cell stays black
   char tag[64];  // e.g. "infolerp 5%", for the time lines
   std::snprintf(tag, sizeof tag, "%s %g%%", p.method.c_str(), 100.0 * p.fraction);
   const stopwatch render_watch;
@@ -208,6 +209,11 @@ inline bool lod_orbit(demo_context& ctx, const support::embree_device& device, v
     const support::camera behind = support::mesh_view_camera((k + cameras / 2) % cameras, cameras, m.positions);
     lod_panel p{"infolerp", 0.05, {}, 0.0, {}, {}, {}};
     if (auto s = lod_frame(lod, h, lod_eye(c, side), m.triangle_count(), p); !s) return report(s), false;
+    if (p.indices.empty()) {  // the coarsest cut of a mesh of a few triangles may draw none
+      images[k] = images[cameras + k] = support::image(side, side);
+      std::printf("  camera %u: no triangle drawn\n", k);
+      continue;
+    }
     std::vector<glm::uvec3> tris(p.indices.size() / 3);
     for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = {p.indices[3 * t], p.indices[3 * t + 1], p.indices[3 * t + 2]};
     support::embree_scene scene(device);

@@ -37,13 +37,13 @@ inline std::string shell_quote(const std::string& s) {
 // cannot be written (reported).
 inline bool lod_summary(const demo_context& ctx) {
   if (ctx.lod_results.empty()) return true;
-  std::printf("\n%-14s %8s %10s %10s %12s %10s %10s %7s\n", "LOD method", "fraction", "triangles", "time (s)",
+  std::printf("\n%-16s %8s %10s %10s %12s %10s %10s %7s\n", "LOD method", "fraction", "triangles", "time (s)",
               "weighted d.", "Hausdorff", "PSNR (dB)", "SSIM");
   for (const auto& r : ctx.lod_results)
-    std::printf("%-14s %7.0f%% %10zu %10.6f %12.4g %10.4g %10.2f %7.4f\n", r.method.c_str(), 100.0 * r.fraction, r.triangles,
+    std::printf("%-16s %7.0f%% %10zu %10.6f %12.4g %10.4g %10.2f %7.4f\n", r.method.c_str(), 100.0 * r.fraction, r.triangles,
                 r.seconds, r.weighted_distance, r.hausdorff, r.psnr, r.ssim);
   std::printf("(distances to the full mesh; PSNR and SSIM against the full mesh's image of the same view; "
-              "time of the frame() update or the meshopt_simplify call)\n");
+              "time of the per-frame step: frame(), or the peer's culling pass)\n");
   const std::string path = (ctx.options.out_dir / "lod.csv").string();
   std::ofstream csv(path);
   csv << "method,fraction,triangles,seconds,weighted_distance,hausdorff,psnr_db,ssim\n";

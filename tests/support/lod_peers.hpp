@@ -83,6 +83,8 @@ inline void cull_triangles(const cull_source& s, const infolerp::view_frustum& v
 // through the eye, normal cone (meshoptimizer's test) where the meshlet lies on a closed part.
 inline void cull_meshlets(const cull_source& s, const infolerp::view_frustum& v, bool back_faces,
                           std::span<const std::uint32_t> lod, std::vector<std::uint32_t>& out) {
+  out.clear();
+  if (lod.empty()) return;  // meshoptimizer builds no meshlets of nothing
   const auto& pos = s.mesh->positions;
   const std::size_t max_v = 64, max_t = 124;
   const std::size_t bound = meshopt_buildMeshletsBound(lod.size(), max_v, max_t);
