@@ -380,26 +380,6 @@ view_distances vertex_distances(const indexed_mesh& m, const std::vector<double>
   return {den > 0.0 ? num / den : 0.0, sden > 0.0 ? snum / sden : 0.0};
 }
 
-// The 8 orbit cameras of support/mesh_views.hpp and 8 close ones: the same directions turned by
-// half a step, the eye at 1.2 bounding radii from the box centre looking at it, so that the
-// mesh overflows the 40° frustum.
-std::vector<support::camera> view_cameras(const indexed_mesh& m) {
-  std::vector<support::camera> cams;
-  for (unsigned k = 0; k < 8; ++k) cams.push_back(support::mesh_view_camera(k, 8, m.positions));
-  const auto close = static_cast<float>(1.2 * 0.5 * mesh_bounds(m).diagonal());
-  for (unsigned k = 0; k < 8; ++k) {
-    support::camera c = support::mesh_view_camera(2 * k + 1, 16, m.positions);
-    c.eye = c.target + close * glm::normalize(c.eye - c.target);
-    cams.push_back(c);
-  }
-  return cams;
-}
-
-lod_camera to_lod_camera(const support::camera& c, std::uint32_t size) {
-  return {glm::dvec3(c.eye), glm::dvec3(c.target - c.eye), glm::dvec3(c.up),
-          static_cast<double>(c.vertical_fov_degrees) * 3.141592653589793 / 180.0, size, size};
-}
-
 double g_view_fraction = 0.0;  // --fraction: only this one (0: all)
 lod_options g_lod;             // --hidden, --silhouette, --near: the view weights of the default selection
 
@@ -442,7 +422,7 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
   std::vector<double> sorted = p.saliency;
   std::sort(sorted.begin(), sorted.end());
   const double salient_cut = sorted[static_cast<std::size_t>(0.9 * static_cast<double>(sorted.size()))];
-  const std::vector<support::camera> cams = view_cameras(m);
+  const std::vector<support::camera> cams = support::lod_view_cameras(m);
   const support::mesh_view_options vopt;  // shadow and AO rays against the drawn triangles
   const std::span<const std::uint32_t> original(reinterpret_cast<const std::uint32_t*>(m.triangles.data()), 3 * nt);
   support::mesh_view_options with_full = vopt;  // ... against the full mesh
@@ -467,7 +447,7 @@ void view_rows(std::FILE* csv, const support::embree_device& device, const std::
     const auto target = static_cast<std::size_t>(std::lround(f * static_cast<double>(nt)));
     double psnr_sum[methods] = {}, salient_sum[methods] = {}, worst_culled = 1e30, worst_meshlets = 1e30;
     for (std::size_t v = 0; v < cams.size(); ++v) {
-      const lod_camera cam = to_lod_camera(cams[v], static_cast<std::uint32_t>(vopt.width));
+      const lod_camera cam = support::to_lod_camera(cams[v], static_cast<std::uint32_t>(vopt.width));
       const std::string view = (v < 8 ? "orbit" : "close") + std::to_string(v % 8);
       std::size_t drawn = 0;
       double psnr[methods] = {};

@@ -68,6 +68,7 @@
 #include "infolerp/lod/hidden_triangles.hpp"
 #include "infolerp/mesh/geometry.hpp"
 #include "pareto.hpp"
+#include "support/lod_peers.hpp"
 #include "support/mesh_io.hpp"
 #include "support/mesh_views.hpp"
 
@@ -396,25 +397,6 @@ std::size_t open_edges(const std::vector<std::uint32_t>& idx) {
   return bad;
 }
 
-// lod.cpp's cameras: 8 orbit ones (support/mesh_views.hpp) and 8 close ones between them at 1.2
-// bounding radii from the box centre.
-std::vector<support::camera> view_cameras(const indexed_mesh& m) {
-  std::vector<support::camera> cams;
-  for (unsigned k = 0; k < 8; ++k) cams.push_back(support::mesh_view_camera(k, 8, m.positions));
-  const auto close = static_cast<float>(1.2 * 0.5 * mesh_bounds(m).diagonal());
-  for (unsigned k = 0; k < 8; ++k) {
-    support::camera c = support::mesh_view_camera(2 * k + 1, 16, m.positions);
-    c.eye = c.target + close * glm::normalize(c.eye - c.target);
-    cams.push_back(c);
-  }
-  return cams;
-}
-
-lod_camera to_lod_camera(const support::camera& c, std::uint32_t size) {
-  return {glm::dvec3(c.eye), glm::dvec3(c.target - c.eye), glm::dvec3(c.up),
-          static_cast<double>(c.vertical_fov_degrees) * 3.141592653589793 / 180.0, size, size};
-}
-
 // meshopt_simplify of the whole mesh whose culled output draws the count nearest `goal`
 // (bisection on the target, interpolation steps alternating with halvings); out: the drawn triangles.
 std::size_t peer_at(const indexed_mesh& m, std::span<const std::uint32_t> all, const culler& cl, std::size_t goal,
@@ -472,7 +454,7 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
     std::fprintf(o, "build,%s,%zu,%zu,%zu,%zu,%zu,%zu,%.4f\n", name.c_str(), nt, d.clusters(), d.group.size(), d.levels, d.terminal,
                  coarsest, build_s);
   const std::vector<std::uint8_t> closed = closed_vertices(m, all);
-  const std::vector<support::camera> cams = view_cameras(m);
+  const std::vector<support::camera> cams = support::lod_view_cameras(m);
   support::mesh_view_options with_full;
   with_full.occluders = all;
   std::vector<support::image> full;
@@ -490,7 +472,7 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
     const auto target = static_cast<std::size_t>(std::lround(f * static_cast<double>(nt)));
     stats view_peer, uni_peer, view_uni;
     for (std::size_t v = 0; v < cams.size(); ++v) {
-      const lod_camera cam = to_lod_camera(cams[v], size);
+      const lod_camera cam = support::to_lod_camera(cams[v], size);
       const culler cl = make_culler(cam, m, all, closed);
       const double focal = 0.5 * static_cast<double>(size) / std::tan(0.5 * cam.vertical_fov);
       const std::string view = (v < 8 ? "orbit" : "close") + std::to_string(v % 8);
@@ -532,7 +514,7 @@ void mesh_rows(std::FILE* csv, const support::embree_device& device, const std::
   const auto target = static_cast<std::size_t>(std::lround(0.05 * static_cast<double>(nt)));
   std::vector<std::uint32_t> copy(all.size());
   for (std::size_t v : {std::size_t{0}, std::size_t{8}}) {
-    const lod_camera cam = to_lod_camera(cams[v], size);
+    const lod_camera cam = support::to_lod_camera(cams[v], size);
     const double focal = 0.5 * static_cast<double>(size) / std::tan(0.5 * cam.vertical_fov);
     const culler cl = make_culler(cam, m, all, closed);
     group_errors(d, cam.position, focal, znear, true, err);

@@ -26,8 +26,31 @@
 #include <glm/geometric.hpp>
 #include "infolerp/lod/hidden_triangles.hpp"
 #include "infolerp/mesh/adaptors.hpp"
+#include "infolerp/mesh/geometry.hpp"
+#include "support/mesh_views.hpp"
 
 namespace infolerp::support {
+
+// The LOD harness's cameras: the 8 orbit cameras of mesh_views.hpp (whole mesh in frame) and 8
+// close ones between them, the eye at 1.2 bounding radii from the box centre (the mesh
+// overflows the frustum).
+inline std::vector<camera> lod_view_cameras(const indexed_mesh& m) {
+  std::vector<camera> cams;
+  for (unsigned k = 0; k < 8; ++k) cams.push_back(mesh_view_camera(k, 8, m.positions));
+  const auto close = static_cast<float>(1.2 * 0.5 * mesh_bounds(m).diagonal());
+  for (unsigned k = 0; k < 8; ++k) {
+    camera c = mesh_view_camera(2 * k + 1, 16, m.positions);
+    c.eye = c.target + close * glm::normalize(c.eye - c.target);
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+// view_dependent_lod's camera for a support camera on a size x size viewport.
+inline lod_camera to_lod_camera(const camera& c, std::uint32_t size) {
+  return {glm::dvec3(c.eye), glm::dvec3(c.target - c.eye), glm::dvec3(c.up),
+          static_cast<double>(c.vertical_fov_degrees) * 3.141592653589793 / 180.0, size, size};
+}
 
 // What culling needs from the full mesh, built once per mesh.
 struct cull_source {
