@@ -1,12 +1,10 @@
 #pragma once
 // What the I-Buffer upsampler asks of the engine: a sample source.
 //
-// Paper: "Feature-based clustered geometry for interpolated Ray-casting", §4 and §4.1. Each
-// I-Buffer sample stores "its position, texture coordinates, cluster ID, normal", the ratio of
-// occluded samples for soft shadows and ambient occlusion (§4) and hard-shadow light bits in one
-// integer (§4.1). Texture coordinates are interpolated, never textured colours (§5, Fig. 12).
-// Beyond the paper: the default record interpolates perspective-correctly when the engine fills
-// inv_depth (1 / view depth); screen-linear weights misplace texcoords on oblique surfaces.
+// Clustering paper §4–4.1: a sample holds position, texcoords, cluster id, normal, soft-shadow
+// and AO ratios and hard-shadow light bits; texcoords are interpolated, never textured colours
+// (§5). Beyond the paper: the default record interpolates perspective-correctly when the engine
+// fills inv_depth (1 / view depth).
 //
 // A sample source S models:
 //   typename S::sample_type                               the I-Buffer record (copyable)
@@ -23,9 +21,8 @@
 // (the cropped border of §4); a pinhole camera extrapolates naturally.
 //
 // Optional members (found by concepts below; member or ADL where noted):
-//   sample_type probe(uint32_t x, uint32_t y) const      the cheap, sharp part of a sample (the
-//        CPU counterpart of a rasteriser's cluster-ID buffer): primary hit, cluster id, position,
-//        normal, texcoords, hard-shadow bits; occlusion left unset
+//   sample_type probe(uint32_t x, uint32_t y) const      the cheap, sharp part of a sample (a
+//        rasteriser's cluster-ID buffer on the CPU): everything but the occlusion terms
 //   sample_type interpolate(probe, a, b) / (probe, a, b, c, d)   with probes: the probe completed
 //        with the expensive, smooth terms of its sources (member or ADL)
 //   bool probe_compatible(probe, s)      default compatible(): for probes that leave out part of it
@@ -36,8 +33,7 @@
 //   bool smooth(a, b) const   with probes only where sources differ: may a sample between a and b
 //        take its geometry from them unprobed (e.g. normals_within below)
 //   bool agree(a, b) const    beyond the paper: a new sample is evaluated unless every pair of its
-//        sources agrees (e.g. occlusion_within below); need not be transitive, and a source that
-//        always agrees gives exactly the frame of one without it
+//        sources agrees (e.g. occlusion_within below); need not be transitive
 //   sample_type evaluate(const sample_type& probe, uint32_t x, uint32_t y) const   with probes: the
 //        full evaluation of pixel (x, y) from its probe (refined first when the source refines),
 //        the same record as evaluate(x, y) without tracing again what the probe traced
