@@ -87,19 +87,23 @@ struct material_channel {
   }
 };
 
+// A clustering of a cube: 6 clusters, two triangles together exactly when their normals agree.
+void check_cube_faces(const indexed_mesh& cube, const result<mesh_clustering>& r) {
+  REQUIRE(r.ok());
+  check_invariants(cube, *r);
+  REQUIRE(r->cluster_count == 6);
+  const auto n = face_normals(cube);
+  for (std::size_t a = 0; a < n.size(); ++a)
+    for (std::size_t b = 0; b < n.size(); ++b) REQUIRE((r->cluster_of[a] == r->cluster_of[b]) == (n[a] == n[b]));
+}
+
 }  // namespace
 
 TEST_CASE("a cube splits into its 6 faces under orientation", "[cluster]") {
   const auto cube = support::make_box({-1, -1, -1}, {1, 1, 1});
   const test::brute_tracer tracer(cube);
   for (std::uint32_t bins : {0u, 64u, 1024u}) {
-    auto r = cluster_mesh(cube, tracer, serial, orientation_channel{.threshold = 0.05, .bins = bins});
-    REQUIRE(r.ok());
-    check_invariants(cube, *r);
-    REQUIRE(r->cluster_count == 6);
-    const auto n = face_normals(cube);
-    for (std::size_t a = 0; a < n.size(); ++a)
-      for (std::size_t b = 0; b < n.size(); ++b) REQUIRE((r->cluster_of[a] == r->cluster_of[b]) == (n[a] == n[b]));
+    check_cube_faces(cube, cluster_mesh(cube, tracer, serial, orientation_channel{.threshold = 0.05, .bins = bins}));
   }
   // A finely tessellated cube too (planar faces of many triangles, one class each).
   indexed_mesh fine;
@@ -122,13 +126,7 @@ TEST_CASE("a cube splits into its 6 faces under orientation", "[cluster]") {
 TEST_CASE("channels that trace nothing run with no_tracer", "[cluster]") {
   // The cube's faces from their normals (the reference), with no tracer in the call.
   const auto cube = support::make_box({-1, -1, -1}, {1, 1, 1});
-  auto r = cluster_mesh(cube, no_tracer{}, serial, orientation_channel{.threshold = 0.05});
-  REQUIRE(r.ok());
-  check_invariants(cube, *r);
-  REQUIRE(r->cluster_count == 6);
-  const auto n = face_normals(cube);
-  for (std::size_t a = 0; a < n.size(); ++a)
-    for (std::size_t b = 0; b < n.size(); ++b) REQUIRE((r->cluster_of[a] == r->cluster_of[b]) == (n[a] == n[b]));
+  check_cube_faces(cube, cluster_mesh(cube, no_tracer{}, serial, orientation_channel{.threshold = 0.05}));
   // Orientation then stretch on a textured mesh: the tracer, never called, changes nothing.
   const auto sphere = support::make_uv_sphere(16, 12);
   const test::brute_tracer tracer(sphere);

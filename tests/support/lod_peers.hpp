@@ -158,7 +158,6 @@ peer_frame uniform_lod_drawing(const cull_source& s, const infolerp::lod_camera&
   // Bracket: lo draws at most `drawn` (the best so far), hi more; secant steps on the visible
   // share, then bisection to 1/1000 of the count.
   std::size_t lo = 0, hi = nt + 1, target = std::max<std::size_t>(drawn, 1);
-  best.lod.clear(), best.drawn.clear();
   if (at(nt, trial) <= drawn) lo = hi = nt, std::swap(best, trial);  // the full mesh fits
   for (int step = 0; step < 40 && hi > lo && hi - lo > std::max<std::size_t>(1, drawn / 1000); ++step) {
     const std::size_t got = at(target, trial);

@@ -58,17 +58,14 @@ class lod_mesh {
   }
   [[nodiscard]] const contraction_hierarchy& hierarchy() const { return *hierarchy_; }
   [[nodiscard]] const cluster_table& clusters() const { return *table_; }
-  [[nodiscard]] const std::vector<std::uint32_t>& triangle_cluster() const { return cluster_; }
   [[nodiscard]] view_dependent_lod& lod() { return lod_; }
 
-  lod_mesh(std::unique_ptr<contraction_hierarchy> h, std::unique_ptr<cluster_table> t, std::vector<std::uint32_t> cluster,
-           view_dependent_lod lod)
-      : hierarchy_(std::move(h)), table_(std::move(t)), cluster_(std::move(cluster)), lod_(std::move(lod)) {}
+  lod_mesh(std::unique_ptr<contraction_hierarchy> h, std::unique_ptr<cluster_table> t, view_dependent_lod lod)
+      : hierarchy_(std::move(h)), table_(std::move(t)), lod_(std::move(lod)) {}
 
  private:
   std::unique_ptr<contraction_hierarchy> hierarchy_;  // on the heap: lod_ points at it
   std::unique_ptr<cluster_table> table_;
-  std::vector<std::uint32_t> cluster_;  // per input triangle: its salient cluster
   view_dependent_lod lod_;
 };
 
@@ -100,7 +97,7 @@ result<lod_mesh> make_lod_mesh(const M& m, std::span<const double> saliency = {}
   auto tp = std::make_unique<cluster_table>(std::move(*table));
   auto lod = view_dependent_lod::create(*hp, *tp, opt.lod);
   if (!lod.ok()) return lod.error();
-  return lod_mesh(std::move(hp), std::move(tp), std::move(clusters->cluster), std::move(*lod));
+  return lod_mesh(std::move(hp), std::move(tp), std::move(*lod));
 }
 
 }  // namespace infolerp

@@ -309,21 +309,22 @@ inline selection_stats select_for_view(const contraction_hierarchy& h, const nei
   // between the largest whose matched removal falls short of the frame's (lo) and the smallest
   // that reaches it (hi).
   double lo = 0.0, hi = goal;
-  bool lo_run = false;
-  if (!run(goal)) lo = goal, lo_run = true, hi = seen_total;
-  if (lo_run && !run(hi)) lo = hi;  // matching never reaches the goal: the top-up below does
-  else
-    while (hi - lo > std::max(1.0, goal / 1024.0)) {
-      const double mid = 0.5 * (lo + hi);
-      const bool enough = run(mid);
-      (enough ? hi : lo) = mid;
-      lo_run = lo_run || !enough;
-    }
+  bool lo_run = false, at_lo = false;  // lo has been run; the last run was lo's
+  if (!run(goal)) {
+    lo_run = true, lo = goal, hi = seen_total;
+    if ((at_lo = !run(hi))) lo = hi;  // matching never reaches the goal: the top-up below does
+  }
+  while (hi - lo > std::max(1.0, goal / 1024.0)) {
+    const double mid = 0.5 * (lo + hi);
+    at_lo = !run(mid);
+    (at_lo ? lo : hi) = mid;
+    lo_run = lo_run || at_lo;
+  }
   // Top-up: lo's cut (none when lo was never run) raised to at least a global prefix P, the
   // shortest that reaches the goal. The maximum of two dependency-closed stop vectors is closed,
   // and so is a prefix, so no matching is needed; a prefix step is one contraction, so the
   // frame's estimate lands within a contraction of its count. budget holds lo's stop points.
-  if (lo_run) run(lo);
+  if (lo_run && !at_lo) run(lo);
   for (const std::uint32_t c : active) budget[c] = lo_run ? stop[c] : 0;
   auto removal_at = [&](std::uint32_t p) {
     double removed = 0.0;
